@@ -1,0 +1,1 @@
+//! Reports: error against run time.

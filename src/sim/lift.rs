@@ -1,0 +1,199 @@
+//! Lifting a surface parcel without mixing (what MetPy's `parcel_profile`
+//! does): dry adiabat to the lifting condensation level, then a moist
+//! adiabat, either pseudo-adiabatic (condensate falls out) or reversible
+//! (condensate carried, `θ_l` and `q_t` conserved).
+
+use serde::{Deserialize, Serialize};
+
+use super::atmosphere::Atmosphere;
+use super::constants::{C_P, EPSILON, G, KAPPA, L_V, R_D, VIRTUAL_COEFF};
+use super::sounding::Sounding;
+use super::thermo::{dewpoint, exner, saturation_adjust, saturation_mixing_ratio};
+
+/// Which moist adiabat the parcel follows above its LCL.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Adiabat {
+    /// Condensate removed as it forms (meteorologists' default).
+    #[default]
+    Pseudo,
+    /// Condensate carried with the parcel.
+    Reversible,
+}
+
+/// The lifting condensation level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lcl {
+    /// Pressure, Pa.
+    pub pressure_pa: f64,
+    /// Temperature, K.
+    pub temperature_k: f64,
+}
+
+/// LCL of air at `t_k`, vapour mixing ratio `qv`, pressure `p_pa`: where the
+/// dry adiabat meets the dewpoint of the conserved mixing ratio. Solved by
+/// bisection to 1e-6 Pa. Saturated (or supersaturated) air is at its LCL.
+pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
+    let Some(td0) = dewpoint(qv, p_pa) else {
+        // Dry air never condenses: report the top of the atmosphere.
+        return Lcl { pressure_pa: 0.0, temperature_k: 0.0 };
+    };
+    if td0 >= t_k {
+        return Lcl { pressure_pa: p_pa, temperature_k: t_k };
+    }
+    let gap = |p: f64| t_k * (p / p_pa).powf(KAPPA) - dewpoint(qv, p).unwrap_or(0.0);
+    let (mut lo, mut hi) = (1.0_f64, p_pa);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if gap(mid) > 0.0 { hi = mid } else { lo = mid }
+        if hi - lo < 1e-6 {
+            break;
+        }
+    }
+    let p = 0.5 * (lo + hi);
+    Lcl { pressure_pa: p, temperature_k: t_k * (p / p_pa).powf(KAPPA) }
+}
+
+/// Pseudo-adiabatic lapse `dT/dp`, K/Pa (the form MetPy's `moist_lapse`
+/// integrates): `(R_d T + L_v r_s) / (c_p + L_v² r_s ε / (R_d T²)) / p`.
+fn pseudo_lapse(t: f64, p: f64) -> f64 {
+    let rs = saturation_mixing_ratio(t, p);
+    (R_D * t + L_V * rs) / (C_P + L_V * L_V * rs * EPSILON / (R_D * t * t)) / p
+}
+
+/// Integrates the pseudo-adiabat from `(t, p0)` to `p1` with RK4 in steps of
+/// at most 50 Pa.
+pub fn pseudo_adiabat(t: f64, p0: f64, p1: f64) -> f64 {
+    let n = ((p1 - p0).abs() / 50.0).ceil().max(1.0) as usize;
+    let dp = (p1 - p0) / n as f64;
+    let (mut t, mut p) = (t, p0);
+    for _ in 0..n {
+        let k1 = pseudo_lapse(t, p);
+        let k2 = pseudo_lapse(t + 0.5 * dp * k1, p + 0.5 * dp);
+        let k3 = pseudo_lapse(t + 0.5 * dp * k2, p + 0.5 * dp);
+        let k4 = pseudo_lapse(t + dp * k3, p + dp);
+        t += dp / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        p += dp;
+    }
+    t
+}
+
+/// One level of a lifted parcel's profile.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProfileRow {
+    pub height_m: f64,
+    pub pressure_pa: f64,
+    pub env_t_k: f64,
+    pub parcel_t_k: f64,
+    pub parcel_qv: f64,
+    pub parcel_qc: f64,
+    /// `g (T_v,parcel - T_v,env) / T_v,env`, m/s².
+    pub buoyancy: f64,
+}
+
+/// A lifted surface parcel: its LCL (with height) and one row per level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Profile {
+    pub lcl: Lcl,
+    /// Height of the LCL above ground, m (log-pressure interpolation between
+    /// levels); `None` if the parcel never saturates within the sounding.
+    pub lcl_height_m: Option<f64>,
+    pub rows: Vec<ProfileRow>,
+}
+
+/// Lifts the sounding's lowest level through all its levels.
+pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
+    let lv = s.levels();
+    let p_of = |i: usize| lv[i].pressure_pa.unwrap_or(f64::NAN);
+    let (t0, q0, p0) = (lv[0].temperature_k, lv[0].mixing_ratio, p_of(0));
+    let q0v = q0.min(saturation_mixing_ratio(t0, p0));
+    let lcl = lcl(t0, q0v, p0);
+    let lcl_height_m = (1..lv.len()).find(|&i| p_of(i) <= lcl.pressure_pa).map(|i| {
+        let (pa, pb) = (p_of(i - 1), p_of(i));
+        let f = ((lcl.pressure_pa.ln() - pa.ln()) / (pb.ln() - pa.ln())).clamp(0.0, 1.0);
+        lv[i - 1].height_m + f * (lv[i].height_m - lv[i - 1].height_m)
+    });
+    let lcl_height_m = if lcl.pressure_pa >= p0 { Some(lv[0].height_m) } else { lcl_height_m };
+    let theta_l = t0 / exner(p0) - L_V * (q0 - q0v) / (C_P * exner(p0));
+    let rows = lv
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let p = p_of(i);
+            let (t, qv, qc) = if p >= lcl.pressure_pa {
+                (t0 * (p / p0).powf(KAPPA), q0v, 0.0)
+            } else {
+                match adiabat {
+                    Adiabat::Pseudo => {
+                        let t = pseudo_adiabat(lcl.temperature_k, lcl.pressure_pa, p);
+                        (t, saturation_mixing_ratio(t, p), 0.0)
+                    }
+                    Adiabat::Reversible => {
+                        let a = saturation_adjust(theta_l, q0, p, exner(p));
+                        (a.t_k, a.qv, a.qc)
+                    }
+                }
+            };
+            let qs_env = saturation_mixing_ratio(l.temperature_k, p);
+            let env_qv = l.mixing_ratio.min(qs_env);
+            let env_qc = l.mixing_ratio - env_qv;
+            let tv_env = l.temperature_k * (1.0 + VIRTUAL_COEFF * env_qv - env_qc);
+            let tv = t * (1.0 + VIRTUAL_COEFF * qv - qc);
+            ProfileRow {
+                height_m: l.height_m,
+                pressure_pa: p,
+                env_t_k: l.temperature_k,
+                parcel_t_k: t,
+                parcel_qv: qv,
+                parcel_qc: qc,
+                buoyancy: G * (tv - tv_env) / tv_env,
+            }
+        })
+        .collect();
+    Profile { lcl, lcl_height_m, rows }
+}
+
+/// LCL height (m) of the air at the bottom of a tabulated atmosphere, if it
+/// condenses below the table's top: the default cloud base.
+pub fn surface_lcl_height(atm: &Atmosphere) -> Option<f64> {
+    let e = atm.at(0.0);
+    let l = lcl(e.t_k, e.qv, e.p_pa);
+    if l.pressure_pa >= e.p_pa {
+        return Some(0.0);
+    }
+    atm.height_at_pressure(l.pressure_pa)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lcl_lies_on_dry_adiabat_and_dewpoint() {
+        let (t, p) = (300.0, 100_000.0);
+        let q = saturation_mixing_ratio(290.0, p);
+        let l = lcl(t, q, p);
+        let td = dewpoint(q, l.pressure_pa).expect("moist");
+        assert!((l.temperature_k - td).abs() < 1e-4);
+        // Bolton (1980) Eq. 15 estimate of T_LCL agrees within 0.1 K.
+        let bolton = 1.0 / (1.0 / (290.0 - 56.0) + (300.0_f64 / 290.0).ln() / 800.0) + 56.0;
+        assert!((l.temperature_k - bolton).abs() < 0.1, "{} vs {bolton}", l.temperature_k);
+    }
+
+    #[test]
+    fn pseudo_adiabat_conserves_bolton_equivalent_potential_temperature() {
+        // Bolton's (1980) Eq. 43 θ_E is an empirical fit; along the exact
+        // pseudo-adiabat it drifts by ~0.9 K over 950-600 hPa, so this is a
+        // sanity bound only. The tight check is against MetPy
+        // (tests/physics_reference.rs, 0.2 K).
+        let thetae = |t: f64, p: f64| {
+            let r = saturation_mixing_ratio(t, p) * 1e3;
+            t * (100_000.0 / p).powf(0.2854 * (1.0 - 0.28e-3 * r))
+                * ((3.376 / t - 0.00254) * r * (1.0 + 0.81e-3 * r)).exp()
+        };
+        let t1 = pseudo_adiabat(295.0, 95_000.0, 60_000.0);
+        let (a, b) = (thetae(295.0, 95_000.0), thetae(t1, 60_000.0));
+        assert!((a - b).abs() < 1.5, "{a} {b} {t1}");
+        assert!(t1 < 295.0 - 15.0);
+    }
+}

@@ -1,0 +1,23 @@
+//! The CPU parcel simulator. Depends on nothing graphical (no wgpu, winit
+//! or egui): researchers can use it on its own.
+
+pub mod atmosphere;
+pub mod budget;
+pub mod config;
+pub mod constants;
+pub mod kernels;
+pub mod lift;
+pub mod parcels;
+pub mod projection;
+pub mod solver;
+pub mod sounding;
+pub mod sph;
+pub mod thermo;
+
+pub use atmosphere::{Atmosphere, EnvSample, ParametricProfile};
+pub use budget::WaterBudget;
+pub use config::PhysicsConfig;
+pub use parcels::Parcels;
+pub use projection::{Band, ProjectedField};
+pub use solver::{Simulation, StepStats, Totals};
+pub use sounding::{Sounding, SoundingError};

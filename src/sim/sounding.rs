@@ -1,0 +1,329 @@
+//! Sounding files: CSV with the header
+//! `height_m,pressure_hPa,temperature_C,dewpoint_C` (or
+//! `relative_humidity_pct` in place of the dewpoint), one row per level,
+//! strictly increasing in height. Pressure may be left empty: it is then
+//! filled by hydrostatic integration from the nearest level below that has
+//! one (or, for the lowest levels, from the nearest above, or from the
+//! scene's surface pressure when no row has one).
+
+use std::path::{Path, PathBuf};
+
+use super::constants::{G, R_D, ZERO_CELSIUS_K};
+use super::thermo::{mixing_ratio_from_dewpoint, saturation_mixing_ratio};
+
+/// What went wrong reading a sounding; every message names the file and,
+/// where there is one, the line and column.
+#[derive(Debug, thiserror::Error)]
+pub enum SoundingError {
+    #[error("{path}: cannot read sounding: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}: {message}")]
+    Invalid {
+        path: PathBuf,
+        line: u64,
+        message: String,
+    },
+}
+
+/// One level of a sounding, in SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Level {
+    /// Height above ground, m.
+    pub height_m: f64,
+    /// Pressure, Pa (always `Some` once the sounding is loaded).
+    pub pressure_pa: Option<f64>,
+    /// Temperature, K.
+    pub temperature_k: f64,
+    /// Water-vapour mixing ratio, kg/kg (may exceed saturation).
+    pub mixing_ratio: f64,
+}
+
+/// A validated sounding.
+#[derive(Debug, Clone)]
+pub struct Sounding {
+    levels: Vec<Level>,
+    source: PathBuf,
+}
+
+enum Humidity {
+    DewpointC,
+    RelativeHumidityPct,
+}
+
+impl Sounding {
+    /// Reads and validates a sounding file. `surface_pressure_pa` anchors the
+    /// hydrostatic integration when no row gives a pressure.
+    pub fn load(path: &Path, surface_pressure_pa: f64) -> Result<Self, SoundingError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SoundingError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::parse(&text, path, surface_pressure_pa)
+    }
+
+    /// Parses sounding text; `path` is only used in messages.
+    pub fn parse(text: &str, path: &Path, surface_pressure_pa: f64) -> Result<Self, SoundingError> {
+        let err = |line: u64, message: String| SoundingError::Invalid {
+            path: path.to_owned(),
+            line,
+            message,
+        };
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_reader(text.as_bytes());
+        let headers = reader
+            .headers()
+            .map_err(|e| err(1, format!("cannot read header: {e}")))?
+            .clone();
+        let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
+        let header_line = reader.position().line().max(1);
+        let need = |name: &str| {
+            col(name).ok_or_else(|| {
+                err(
+                    header_line,
+                    format!(
+                        "missing column `{name}`; expected header \
+                         `height_m,pressure_hPa,temperature_C,dewpoint_C` \
+                         (or relative_humidity_pct instead of dewpoint_C)"
+                    ),
+                )
+            })
+        };
+        let c_h = need("height_m")?;
+        let c_p = need("pressure_hPa")?;
+        let c_t = need("temperature_C")?;
+        let (c_q, humidity) = match (col("dewpoint_C"), col("relative_humidity_pct")) {
+            (Some(c), _) => (c, Humidity::DewpointC),
+            (None, Some(c)) => (c, Humidity::RelativeHumidityPct),
+            (None, None) => return Err(need("dewpoint_C").unwrap_err()),
+        };
+
+        struct Row {
+            line: u64,
+            h: f64,
+            p: Option<f64>,
+            t: f64,
+            hum: f64,
+        }
+        let mut rows: Vec<Row> = Vec::new();
+        for record in reader.records() {
+            let record = record.map_err(|e| {
+                let line = e.position().map_or(0, |p| p.line());
+                err(line, format!("malformed row: {e}"))
+            })?;
+            let line = record.position().map_or(0, |p| p.line());
+            let field = |c: usize, name: &str| -> Result<Option<f64>, SoundingError> {
+                let s = record.get(c).unwrap_or("");
+                if s.is_empty() {
+                    return Ok(None);
+                }
+                let v: f64 = s
+                    .parse()
+                    .map_err(|_| err(line, format!("`{name}` is `{s}`, expected a number")))?;
+                if !v.is_finite() {
+                    return Err(err(line, format!("`{name}` is `{s}`, expected a finite number")));
+                }
+                Ok(Some(v))
+            };
+            let required = |c: usize, name: &str| -> Result<f64, SoundingError> {
+                field(c, name)?.ok_or_else(|| err(line, format!("`{name}` is empty")))
+            };
+            let h = required(c_h, "height_m")?;
+            let p = field(c_p, "pressure_hPa")?;
+            let t = required(c_t, "temperature_C")?;
+            let hum = required(
+                c_q,
+                match humidity {
+                    Humidity::DewpointC => "dewpoint_C",
+                    Humidity::RelativeHumidityPct => "relative_humidity_pct",
+                },
+            )?;
+            if h < 0.0 {
+                return Err(err(line, format!("`height_m` is {h}, expected >= 0 (height above ground)")));
+            }
+            if let Some(p) = p {
+                if !(1.0..=1200.0).contains(&p) {
+                    return Err(err(line, format!("`pressure_hPa` is {p}, expected 1..=1200")));
+                }
+            }
+            if !(-120.0..=70.0).contains(&t) {
+                return Err(err(line, format!("`temperature_C` is {t}, expected -120..=70")));
+            }
+            match humidity {
+                Humidity::DewpointC if hum > t + 10.0 || hum < -150.0 => {
+                    return Err(err(
+                        line,
+                        format!("`dewpoint_C` is {hum}, expected -150..=temperature_C + 10"),
+                    ));
+                }
+                Humidity::RelativeHumidityPct if !(0.0..=150.0).contains(&hum) => {
+                    return Err(err(line, format!("`relative_humidity_pct` is {hum}, expected 0..=150")));
+                }
+                _ => {}
+            }
+            if let Some(prev) = rows.last() {
+                if h <= prev.h {
+                    return Err(err(
+                        line,
+                        format!(
+                            "`height_m` is {h}, not above the previous row's {} (line {}): rows must be sorted by strictly increasing height",
+                            prev.h, prev.line
+                        ),
+                    ));
+                }
+                if let (Some(p), Some(pp)) = (p, prev.p) {
+                    if p >= pp {
+                        return Err(err(line, format!("`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height")));
+                    }
+                }
+            }
+            rows.push(Row { line, h, p, t, hum });
+        }
+        if rows.len() < 2 {
+            return Err(err(
+                header_line,
+                format!("{} data rows, expected at least 2 levels", rows.len()),
+            ));
+        }
+
+        // Pressures: hydrostatic fill of the missing ones.
+        let mut p_pa: Vec<Option<f64>> = rows.iter().map(|r| r.p.map(|p| p * 100.0)).collect();
+        let t_k: Vec<f64> = rows.iter().map(|r| r.t + ZERO_CELSIUS_K).collect();
+        if p_pa.iter().all(Option::is_none) {
+            p_pa[0] = Some(surface_pressure_pa);
+        }
+        let first = p_pa.iter().position(Option::is_some).unwrap_or(0);
+        // Mixing ratio needs pressure; virtual temperature needs mixing
+        // ratio; integrate level to level with 1 m sub-steps.
+        let mixing = |i: usize, p: f64| -> f64 {
+            match humidity {
+                Humidity::DewpointC => mixing_ratio_from_dewpoint(rows[i].hum + ZERO_CELSIUS_K, p),
+                Humidity::RelativeHumidityPct => {
+                    rows[i].hum / 100.0 * saturation_mixing_ratio(t_k[i], p)
+                }
+            }
+        };
+        let integrate = |from: usize, to: usize, p_from: f64| -> f64 {
+            let (a, b) = (from, to);
+            let dz_total = rows[b].h - rows[a].h;
+            let steps = (dz_total.abs().ceil() as usize).max(1);
+            let dz = dz_total / steps as f64;
+            let mut ln_p = p_from.ln();
+            let qa = mixing(a, p_from);
+            let qb_guess = mixing(b, p_from);
+            for s in 0..steps {
+                let f0 = s as f64 / steps as f64;
+                let f1 = (s + 1) as f64 / steps as f64;
+                let tv = |f: f64| {
+                    let t = t_k[a] + f * (t_k[b] - t_k[a]);
+                    let q = qa + f * (qb_guess - qa);
+                    t * (1.0 + 0.608 * q)
+                };
+                ln_p -= G * dz * 0.5 * (1.0 / tv(f0) + 1.0 / tv(f1)) / R_D;
+            }
+            ln_p.exp()
+        };
+        for i in (0..first).rev() {
+            let p_above = p_pa[i + 1].unwrap_or(surface_pressure_pa);
+            p_pa[i] = Some(integrate(i + 1, i, p_above));
+        }
+        for i in first + 1..rows.len() {
+            if p_pa[i].is_none() {
+                let p_below = p_pa[i - 1].unwrap_or(surface_pressure_pa);
+                p_pa[i] = Some(integrate(i - 1, i, p_below));
+            }
+        }
+        let levels = rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let p = p_pa[i].unwrap_or(surface_pressure_pa);
+                Level {
+                    height_m: r.h,
+                    pressure_pa: Some(p),
+                    temperature_k: t_k[i],
+                    mixing_ratio: mixing(i, p).max(0.0),
+                }
+            })
+            .collect();
+        Ok(Self {
+            levels,
+            source: path.to_owned(),
+        })
+    }
+
+    /// The levels, lowest first.
+    pub fn levels(&self) -> &[Level] {
+        &self.levels
+    }
+
+    /// The file this sounding came from.
+    pub fn source(&self) -> &Path {
+        &self.source
+    }
+
+    /// The lowest level above 200 m from which temperature does not fall
+    /// with height (a temperature inversion), if there is one below 6 km.
+    pub fn inversion_base_m(&self) -> Option<f64> {
+        self.levels
+            .windows(2)
+            .find(|w| w[0].height_m >= 200.0 && w[0].height_m < 6000.0 && w[1].temperature_k >= w[0].temperature_k)
+            .map(|w| w[0].height_m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Sounding, SoundingError> {
+        Sounding::parse(text, Path::new("s.csv"), 101_325.0)
+    }
+
+    #[test]
+    fn empty_pressure_is_filled_hydrostatically() {
+        let s = parse(
+            "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,10\n1000,,13.5,5\n2000,,7,0\n",
+        )
+        .expect("valid");
+        let p1 = s.levels()[1].pressure_pa.expect("filled");
+        // Scale height ~ 8.4 km at 290 K: p(1 km) ≈ 887 hPa.
+        assert!((p1 / 100.0 - 887.5).abs() < 2.0, "{p1}");
+        let p2 = s.levels()[2].pressure_pa.expect("filled");
+        assert!(p2 < p1);
+    }
+
+    #[test]
+    fn unsorted_rows_name_the_line() {
+        let e = parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,10\n500,950,17,9\n400,960,18,9\n")
+            .expect_err("unsorted");
+        let msg = e.to_string();
+        assert!(msg.starts_with("s.csv:4:"), "{msg}");
+        assert!(msg.contains("strictly increasing height"), "{msg}");
+    }
+
+    #[test]
+    fn non_numeric_field_names_column_and_line() {
+        let e = parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,warm,10\n10,999,20,10\n")
+            .expect_err("non-numeric");
+        let msg = e.to_string();
+        assert!(msg.contains("s.csv:2:") && msg.contains("temperature_C"), "{msg}");
+    }
+
+    #[test]
+    fn nan_is_rejected() {
+        let e = parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,NaN,10\n10,999,20,10\n")
+            .expect_err("nan");
+        assert!(e.to_string().contains("finite"), "{e}");
+    }
+
+    #[test]
+    fn missing_column_is_named() {
+        let e = parse("height_m,temperature_C,dewpoint_C\n0,20,10\n").expect_err("missing");
+        assert!(e.to_string().contains("pressure_hPa"), "{e}");
+    }
+}
