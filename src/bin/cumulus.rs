@@ -1,1 +1,280 @@
-fn main(){}
+//! `cumulus`: the physics command line. Units are in every flag's name and
+//! help text. Errors leave through `anyhow` with the file, line or field.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use cumulus::io::write_atomically;
+use cumulus::report::{convergence, curves};
+use cumulus::scene::Scene;
+use cumulus::sim::lift::{Adiabat, lift_sounding};
+use cumulus::sim::{Simulation, Sounding};
+
+#[derive(Parser)]
+#[command(name = "cumulus", version, about = "Physics-driven cumulus clouds (Goswami, STAG 2019): parcel simulator and tools")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a scene and write the parcel curves (paper's Fig. 5) as CSV.
+    Simulate(SimulateArgs),
+    /// Lift the sounding's lowest air without mixing (like MetPy's
+    /// parcel_profile): print its LCL, write one row per level.
+    Profile(ProfileArgs),
+    /// Error against run time: run a scene at steps from 0.1 s to 600 s
+    /// against a fine reference; write convergence.csv and convergence.png.
+    Convergence(ConvergenceArgs),
+    /// Scene files.
+    Scene {
+        #[command(subcommand)]
+        command: SceneCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Validate a scene (and its sounding); report errors with file, line and key.
+    Check {
+        /// Scene TOML file.
+        file: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct SimulateArgs {
+    /// Scene TOML file.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Sounding CSV replacing the scene's atmosphere (header
+    /// height_m,pressure_hPa,temperature_C,dewpoint_C).
+    #[arg(long)]
+    sounding: Option<PathBuf>,
+    /// Simulated time, seconds.
+    #[arg(long, default_value_t = 3600.0)]
+    duration_s: f64,
+    /// Frame time step, seconds (overrides the scene's physics.dt_s).
+    #[arg(long)]
+    dt_s: Option<f64>,
+    /// Number of parcels (overrides the scene's physics.parcels).
+    #[arg(long)]
+    parcels: Option<usize>,
+    /// Random seed (overrides the scene's physics.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Write rows every this many simulated seconds (default: every frame).
+    #[arg(long)]
+    every_s: Option<f64>,
+    /// Output CSV, one row per parcel per output step (written atomically).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct ProfileArgs {
+    /// Sounding CSV (height_m,pressure_hPa,temperature_C,dewpoint_C).
+    #[arg(long)]
+    sounding: PathBuf,
+    /// Moist adiabat above the LCL: pseudo (condensate removed) or reversible.
+    #[arg(long, value_enum, default_value_t = Adiabat::Pseudo)]
+    adiabat: Adiabat,
+    /// Ground pressure in hPa, used when the sounding gives no pressures.
+    #[arg(long, default_value_t = 1013.25)]
+    surface_pressure_hpa: f64,
+    /// Output CSV, one row per sounding level (written atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct ConvergenceArgs {
+    /// Scene TOML file.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Simulated time per run, seconds (a multiple of 600).
+    #[arg(long, default_value_t = 1800.0)]
+    duration_s: f64,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn main() {
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Simulate(a) => simulate(a),
+        Command::Profile(a) => profile(a),
+        Command::Convergence(a) => convergence_cmd(a),
+        Command::Scene { command: SceneCommand::Check { file } } => {
+            let scene = Scene::load(&file)?;
+            let atm = scene.atmosphere(None)?;
+            let band = scene.band(&atm);
+            println!(
+                "{}: ok ({}; {} parcels, dt {} s, cloud band {:.0}-{:.0} m)",
+                file.display(),
+                if scene.name.is_empty() { "unnamed" } else { &scene.name },
+                scene.physics.parcels,
+                scene.physics.dt_s,
+                band.bottom_m,
+                band.top_m
+            );
+            Ok(())
+        }
+    }
+}
+
+fn progress_bar(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(
+        Some(len),
+        if std::io::stderr().is_terminal() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
+    );
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_owned());
+    bar
+}
+
+fn finite_positive(name: &str, v: f64) -> Result<()> {
+    if !(v.is_finite() && v > 0.0) {
+        bail!("{name} is {v}, expected a positive number of seconds");
+    }
+    Ok(())
+}
+
+fn load_scene(path: &Path) -> Result<Scene> {
+    Ok(Scene::load(path)?)
+}
+
+fn simulate(a: SimulateArgs) -> Result<()> {
+    let mut scene = load_scene(&a.scene)?;
+    if let Some(dt) = a.dt_s {
+        scene.physics.dt_s = dt;
+    }
+    if let Some(n) = a.parcels {
+        scene.physics.parcels = n;
+    }
+    if let Some(s) = a.seed {
+        scene.physics.seed = s;
+    }
+    scene.validate().context("after applying --dt-s/--parcels/--seed")?;
+    finite_positive("--duration-s", a.duration_s)?;
+    let every = a.every_s.unwrap_or(scene.physics.dt_s);
+    finite_positive("--every-s", every)?;
+    let atm = scene.atmosphere(a.sounding.as_deref())?;
+    let band = scene.band(&atm);
+    let frames = (a.duration_s / scene.physics.dt_s).round().max(1.0) as u64;
+    let write_every = (every / scene.physics.dt_s).round().max(1.0) as u64;
+    let mut sim = Simulation::new(scene.physics.clone(), atm);
+    let bar = progress_bar(frames, "simulating");
+    write_atomically(&a.out, |out| {
+        let mut w = csv::Writer::from_writer(out);
+        curves::write_header(&mut w)?;
+        curves::write_rows(&mut w, &sim, band)?;
+        for f in 1..=frames {
+            sim.step();
+            if f % write_every == 0 || f == frames {
+                curves::write_rows(&mut w, &sim, band)?;
+            }
+            bar.inc(1);
+        }
+        w.flush()
+    })
+    .with_context(|| format!("{}: cannot write curves", a.out.display()))?;
+    bar.finish_and_clear();
+    let t = sim.totals();
+    let b = sim.water_budget();
+    eprintln!(
+        "simulated {:.0} s in {} frames ({} sub-steps, {} frames hit the sub-step cap), {} re-births; water budget residual {:.2e} (relative); wrote {}",
+        sim.time_s(),
+        t.frames,
+        t.substeps,
+        t.capped_frames,
+        t.recycled,
+        b.relative_residual(),
+        a.out.display()
+    );
+    Ok(())
+}
+
+fn profile(a: ProfileArgs) -> Result<()> {
+    if !(300.0..=1100.0).contains(&a.surface_pressure_hpa) {
+        bail!("--surface-pressure-hpa is {}, expected 300..=1100", a.surface_pressure_hpa);
+    }
+    let s = Sounding::load(&a.sounding, a.surface_pressure_hpa * 100.0)?;
+    let prof = lift_sounding(&s, a.adiabat);
+    println!("lcl_pressure_hPa={:.3}", prof.lcl.pressure_pa / 100.0);
+    println!("lcl_temperature_K={:.3}", prof.lcl.temperature_k);
+    match prof.lcl_height_m {
+        Some(z) => println!("lcl_height_m={z:.1}"),
+        None => println!("lcl_height_m=none (the parcel does not saturate within the sounding)"),
+    }
+    if let Some(out) = &a.out {
+        write_atomically(out, |w| {
+            writeln!(w, "height_m,pressure_hPa,env_T_K,parcel_T_K,parcel_qv_gkg,parcel_qc_gkg,buoyancy_mps2")?;
+            for r in &prof.rows {
+                writeln!(
+                    w,
+                    "{:.3},{:.4},{:.4},{:.4},{:.5},{:.5},{:.6}",
+                    r.height_m,
+                    r.pressure_pa / 100.0,
+                    r.env_t_k,
+                    r.parcel_t_k,
+                    r.parcel_qv * 1e3,
+                    r.parcel_qc * 1e3,
+                    r.buoyancy
+                )?;
+            }
+            Ok(())
+        })
+        .with_context(|| format!("{}: cannot write profile", out.display()))?;
+    }
+    Ok(())
+}
+
+fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
+    let scene = load_scene(&a.scene)?;
+    if !(a.duration_s >= convergence::COMPARE_EVERY_S && a.duration_s.is_finite()) {
+        bail!("--duration-s is {}, expected at least {} s", a.duration_s, convergence::COMPARE_EVERY_S);
+    }
+    let atm = scene.atmosphere(None)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    let dts = convergence::DEFAULT_DTS_S;
+    let bar = progress_bar(dts.len() as u64 + 1, "convergence");
+    let report = convergence::measure(&scene.physics, &atm, a.duration_s, &dts, || bar.inc(1));
+    bar.finish_and_clear();
+    convergence::write(&report, &a.out)?;
+    println!("reference dt {} s took {:.2} s", report.reference_dt_s, report.reference_wall_s);
+    println!("{:>8} {:>9} {:>9} {:>9} {:>10} {:>10} {:>9} {:>9}", "dt_s", "wall_s", "err_z_m", "err_w", "err_thv_K", "err_qc_gkg", "base_m", "top_m");
+    for r in &report.rows {
+        println!(
+            "{:>8} {:>9.4} {:>9.3} {:>9.4} {:>10.4} {:>10.5} {:>9.2} {:>9.2}",
+            r.dt_s, r.wall_s, r.err_z_m, r.err_w_mps, r.err_theta_v_k, r.err_qc_gkg, r.err_cloud_base_m, r.err_cloud_top_m
+        );
+    }
+    match report.chosen {
+        Some(i) => println!(
+            "least-cost step reaching RMS z error <= {} m and q_c error <= {} g/kg: dt = {} s",
+            convergence::TARGET_Z_M,
+            convergence::TARGET_QC_GKG,
+            report.rows[i].dt_s
+        ),
+        None => println!("no step reached the stated error (z <= {} m, q_c <= {} g/kg)", convergence::TARGET_Z_M, convergence::TARGET_QC_GKG),
+    }
+    println!("wrote {0}/convergence.csv and {0}/convergence.png", a.out.display());
+    Ok(())
+}

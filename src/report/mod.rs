@@ -1,1 +1,15 @@
-//! Reports: error against run time.
+//! Reports built on the simulator: parcel curves (the paper's Fig. 5) as
+//! CSV, and error against run time.
+
+pub mod convergence;
+pub mod curves;
+pub mod plot;
+
+/// What went wrong writing a report.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("{path}: cannot write: {source}")]
+    Write { path: std::path::PathBuf, source: std::io::Error },
+    #[error("plot {path}: {message}")]
+    Plot { path: std::path::PathBuf, message: String },
+}
