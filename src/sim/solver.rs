@@ -133,7 +133,10 @@ impl Simulation {
         for (i, &p) in positions.iter().enumerate() {
             sim.set_parcel(i, p, sim.cfg.initial_excess_k, sim.cfg.initial_excess_qt_gkg * 1e-3);
         }
+        // The placed parcels are the start: open fresh books.
         sim.initial_water_kg = sim.parcels.water_kg();
+        sim.retired_entrained = CompensatedSum::default();
+        sim.retired_detrained = CompensatedSum::default();
         sim
     }
 
