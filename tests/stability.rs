@@ -33,6 +33,9 @@ fn build(layout: Layout, dt: f64, atm: Atmosphere) -> Simulation {
     let cfg = PhysicsConfig { dt_s: dt, release_stagger_s: 0.0, ..PhysicsConfig::default() };
     let l = cfg.domain_size_m;
     match layout {
+        // 10,000 parcels over 100 km keep the default scene's ~1 parcel per
+        // km²; the packed case is `ten_thousand_packed_parcels_stay_finite`.
+        Layout::Count(n) if n > 1000 => Simulation::new(PhysicsConfig { parcels: n, domain_size_m: 100_000.0, ..cfg }, atm),
         Layout::Count(n) => Simulation::new(PhysicsConfig { parcels: n, ..cfg }, atm),
         Layout::OnePoint => Simulation::with_positions(cfg, atm, &vec![DVec3::new(5000.0, 5000.0, 50.0); 200]),
         Layout::Edges => {
@@ -106,6 +109,16 @@ fn a_day_of_simulated_time_keeps_parcels_and_stays_finite() {
     assert!((sim.time_s() - 86_400.0).abs() < 1e-6);
     assert!(sim.totals().recycled > 24, "parcels were re-born, the animation went on: {:?}", sim.totals());
     assert_eq!(sim.totals().capped_frames, 0);
+}
+
+#[test]
+fn ten_thousand_packed_parcels_stay_finite() {
+    // 10,000 parcels of 300 m in a 10 km square overlap ~100-fold: the SPH
+    // pressure is at its stiffest and the sub-step bounds must hold it.
+    let cfg = PhysicsConfig { parcels: 10_000, dt_s: 60.0, release_stagger_s: 0.0, ..PhysicsConfig::default() };
+    let mut sim = Simulation::new(cfg, atmosphere(1.2, 20.0));
+    sim.step();
+    check(&sim, 10_000, "10,000 packed parcels");
 }
 
 #[test]

@@ -85,6 +85,8 @@ struct Ctx<'a> {
     atm: &'a Atmosphere,
     cfg: &'a PhysicsConfig,
     dt: f64,
+    /// Unit vector the wind blows towards.
+    wind_dir: DVec2,
 }
 
 impl Simulation {
@@ -295,10 +297,12 @@ impl Simulation {
             };
             sph::accelerations(&mut self.grid, &self.parcels.pos, &self.parcels.vel, &self.active, &params, &mut self.sph_acc);
         }
+        let a = self.cfg.wind.direction_deg.to_radians();
         let ctx = Ctx {
             atm: &self.atm,
             cfg: &self.cfg,
             dt,
+            wind_dir: DVec2::new(a.sin(), a.cos()),
         };
         let zero = [DVec3::ZERO];
         let acc: &[DVec3] = if sph_on { &self.sph_acc } else { &zero };
@@ -357,13 +361,21 @@ impl Simulation {
 /// The wind at height `z_m` (zero when off), m/s.
 #[inline]
 pub fn wind_at(cfg: &PhysicsConfig, z_m: f64) -> DVec2 {
+    if !cfg.wind.enabled {
+        return DVec2::ZERO;
+    }
+    let a = cfg.wind.direction_deg.to_radians();
+    wind_with_direction(cfg, DVec2::new(a.sin(), a.cos()), z_m)
+}
+
+/// [`wind_at`] with the direction's unit vector already computed.
+#[inline]
+fn wind_with_direction(cfg: &PhysicsConfig, dir: DVec2, z_m: f64) -> DVec2 {
     let w = &cfg.wind;
     if !w.enabled {
         return DVec2::ZERO;
     }
-    let speed = w.speed_mps * (1.0 + w.shear_per_km * z_m.max(0.0) * 1e-3).max(0.0);
-    let a = w.direction_deg.to_radians();
-    DVec2::new(a.sin(), a.cos()) * speed
+    dir * (w.speed_mps * (1.0 + w.shear_per_km * z_m.max(0.0) * 1e-3).max(0.0))
 }
 
 fn air_mass(env: &super::atmosphere::EnvSample, radius_m: f64) -> f64 {
@@ -454,7 +466,7 @@ fn advance_parcel(
     // 1. Half kick.
     let kick = |vel: &mut DVec3, buoyancy: f64, z: f64| {
         vel.z = implicit_drag_kick(vel.z, buoyancy * inv_vm + a_sph.z, k, half);
-        let wind = wind_at(cfg, z);
+        let wind = wind_with_direction(cfg, ctx.wind_dir, z);
         let rel = DVec2::new(vel.x, vel.y) - wind;
         let speed = rel.length();
         let rel = if speed > 0.0 {
@@ -496,7 +508,7 @@ fn advance_parcel(
         *theta_l = env.theta_l + (*theta_l - env.theta_l) * f;
         *qt = env.qt + (*qt - env.qt) * f;
         life.entrained_kg.add((*qt - qt_old) * life.mass_kg);
-        let wind = wind_at(cfg, pos.z);
+        let wind = wind_with_direction(cfg, ctx.wind_dir, pos.z);
         vel.x = wind.x + (vel.x - wind.x) * f;
         vel.y = wind.y + (vel.y - wind.y) * f;
     }

@@ -1,13 +1,14 @@
 //! SPH pressure and viscosity between parcels (Müller et al. 2003), with a
 //! hashed uniform grid for the neighbour search.
 //!
-//! The grid's cells are at least `h` wide, so all neighbours of a parcel lie
-//! in its 27 surrounding cells. Cells hash into `2n` buckets (Teschner et al.
-//! 2003): any `h`, however small next to the domain, costs memory in the
-//! parcel count only. The 27 cells' buckets are de-duplicated before they are
-//! visited, so a periodic domain only a few cells wide, or two cells sharing
-//! a bucket, never counts a neighbour twice; the distance test discards the
-//! strangers a bucket collision brings in.
+//! The grid is dense: cell `(ix, iy, iz)` at index `(iz * nx + iy) * nx +
+//! ix`, filled by a counting sort, so the three cells along x of each of the
+//! 9 (y, z) rows of a query are neighbours in memory. Cells are at least `h`
+//! wide (all neighbours of a parcel lie in its 27 surrounding cells); when a
+//! sparse domain would need more than [`CELLS_PER_PARCEL`] cells a parcel,
+//! the cells grow, which only adds candidates for the distance test. A
+//! periodic domain fewer than 3 cells wide wraps offsets onto one cell;
+//! those are visited once.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -32,6 +33,9 @@ pub struct SphParams {
     pub viscosity: f64,
 }
 
+/// Most cells the grid may have per active parcel (plus a fixed 4096).
+pub const CELLS_PER_PARCEL: usize = 8;
+
 /// Reusable neighbour grid.
 #[derive(Debug, Clone, Default)]
 pub struct NeighbourGrid {
@@ -41,52 +45,65 @@ pub struct NeighbourGrid {
     density: Vec<f64>,
     pressure: Vec<f64>,
     nx: i64,
+    nz: i64,
     cell_xy: f64,
+    cell_z: f64,
     h: f64,
 }
 
 impl NeighbourGrid {
-    fn bucket(&self, ix: i64, iy: i64, iz: i64) -> u32 {
-        let (ix, iy) = (ix.rem_euclid(self.nx), iy.rem_euclid(self.nx));
-        let h = (ix as u64).wrapping_mul(73_856_093)
-            ^ (iy as u64).wrapping_mul(19_349_663)
-            ^ (iz as u64).wrapping_mul(83_492_791);
-        (h % (self.starts.len() as u64 - 1)) as u32
-    }
-
+    #[inline]
     fn cell(&self, p: DVec3) -> (i64, i64, i64) {
         (
-            (p.x / self.cell_xy).floor() as i64,
-            (p.y / self.cell_xy).floor() as i64,
-            (p.z / self.h).floor() as i64,
+            ((p.x / self.cell_xy).floor() as i64).clamp(0, self.nx - 1),
+            ((p.y / self.cell_xy).floor() as i64).clamp(0, self.nx - 1),
+            ((p.z / self.cell_z).floor() as i64).clamp(0, self.nz - 1),
         )
     }
 
-    /// Sorts the active parcels into buckets.
+    #[inline]
+    fn index(&self, ix: i64, iy: i64, iz: i64) -> usize {
+        ((iz * self.nx + iy) * self.nx + ix) as usize
+    }
+
+    /// Sorts the active parcels into cells.
     fn build(&mut self, pos: &[DVec3], active: &[u32], p: &SphParams) {
         self.h = p.h;
-        self.nx = ((p.domain_m / p.h).floor() as i64).max(1);
+        let z_max = active.iter().map(|&i| pos[i as usize].z).fold(0.0_f64, f64::max);
+        let budget = (CELLS_PER_PARCEL * active.len() + 4096) as f64;
+        let mut cell = p.h;
+        loop {
+            let nx = (p.domain_m / cell).floor().max(1.0);
+            let nz = (z_max / cell).floor() + 1.0;
+            if nx * nx * nz <= budget {
+                self.nx = nx as i64;
+                self.nz = nz as i64;
+                break;
+            }
+            cell *= 1.25;
+        }
         self.cell_xy = p.domain_m / self.nx as f64;
-        let buckets = (2 * active.len()).max(1);
+        self.cell_z = cell;
+        let cells = (self.nx * self.nx * self.nz) as usize;
         self.starts.clear();
-        self.starts.resize(buckets + 1, 0);
+        self.starts.resize(cells + 1, 0);
         self.keys.clear();
         for &i in active {
             let (x, y, z) = self.cell(pos[i as usize]);
-            let b = self.bucket(x, y, z);
-            self.keys.push(b);
-            self.starts[b as usize + 1] += 1;
+            let k = self.index(x, y, z);
+            self.keys.push(k as u32);
+            self.starts[k + 1] += 1;
         }
-        for b in 0..buckets {
-            self.starts[b + 1] += self.starts[b];
+        for c in 0..cells {
+            self.starts[c + 1] += self.starts[c];
         }
         self.order.clear();
         self.order.resize(active.len(), 0);
         let mut fill = self.starts.clone();
         for (k, &i) in active.iter().enumerate() {
-            let b = self.keys[k] as usize;
-            self.order[fill[b] as usize] = i;
-            fill[b] += 1;
+            let c = self.keys[k] as usize;
+            self.order[fill[c] as usize] = i;
+            fill[c] += 1;
         }
     }
 
@@ -96,36 +113,52 @@ impl NeighbourGrid {
     fn for_each_neighbour(&self, i: usize, pos: &[DVec3], l: f64, mut f: impl FnMut(usize, DVec3, f64)) {
         let pi = pos[i];
         let (cx, cy, cz) = self.cell(pi);
-        let mut buckets = [0u32; 27];
-        let mut n = 0;
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    buckets[n] = self.bucket(cx + dx, cy + dy, cz + dz);
-                    n += 1;
+        // Distinct wrapped offsets along each axis (fewer than 3 where the
+        // domain is narrower than 3 cells or the column ends).
+        let distinct = |c: i64, n: i64, wrap: bool| {
+            let mut v = [0i64; 3];
+            let mut m = 0;
+            for d in -1..=1 {
+                let x = if wrap { (c + d).rem_euclid(n) } else { c + d };
+                if (0..n).contains(&x) && !v[..m].contains(&x) {
+                    v[m] = x;
+                    m += 1;
                 }
             }
-        }
-        buckets.sort_unstable();
+            (v, m)
+        };
+        let (xs, mx) = distinct(cx, self.nx, true);
+        let (ys, my) = distinct(cy, self.nx, true);
+        let (zs, mz) = distinct(cz, self.nz, false);
         let h2 = self.h * self.h;
-        let mut last = u32::MAX;
-        for &b in &buckets {
-            if b == last {
-                continue;
-            }
-            last = b;
-            let (s, e) = (self.starts[b as usize] as usize, self.starts[b as usize + 1] as usize);
-            for &j in &self.order[s..e] {
-                let j = j as usize;
-                if j == i {
-                    continue;
-                }
-                let mut d = pi - pos[j];
-                d.x -= l * (d.x / l).round();
-                d.y -= l * (d.y / l).round();
-                let r2 = d.length_squared();
-                if r2 < h2 {
-                    f(j, d, r2.sqrt());
+        let half = 0.5 * l;
+        for &iz in &zs[..mz] {
+            for &iy in &ys[..my] {
+                for &ix in &xs[..mx] {
+                    let c = self.index(ix, iy, iz);
+                    let (s, e) = (self.starts[c] as usize, self.starts[c + 1] as usize);
+                    for &j in &self.order[s..e] {
+                        let j = j as usize;
+                        if j == i {
+                            continue;
+                        }
+                        let mut d = pi - pos[j];
+                        // Minimum image in the periodic plane (|d| < l before).
+                        if d.x > half {
+                            d.x -= l;
+                        } else if d.x < -half {
+                            d.x += l;
+                        }
+                        if d.y > half {
+                            d.y -= l;
+                        } else if d.y < -half {
+                            d.y += l;
+                        }
+                        let r2 = d.length_squared();
+                        if r2 < h2 {
+                            f(j, d, r2.sqrt());
+                        }
+                    }
                 }
             }
         }
@@ -171,10 +204,12 @@ pub fn accelerations(
         grid.for_each_neighbour(i, pos, l, |_, _, r| rho += Poly6::w(r, p.h));
         rho
     };
+    // Queries in cell order: consecutive queries read the same cells.
+    let queries = &grid.order;
     let rho: Vec<(u32, f64)> = if parallel {
-        active.par_iter().map(|&i| (i, density_of(i as usize))).collect()
+        queries.par_iter().with_min_len(64).map(|&i| (i, density_of(i as usize))).collect()
     } else {
-        active.iter().map(|&i| (i, density_of(i as usize))).collect()
+        queries.iter().map(|&i| (i, density_of(i as usize))).collect()
     };
     for (i, r) in rho {
         density[i as usize] = r;
@@ -192,9 +227,9 @@ pub fn accelerations(
         a
     };
     let out: Vec<(u32, DVec3)> = if parallel {
-        active.par_iter().map(|&i| (i, accel_of(i as usize))).collect()
+        queries.par_iter().with_min_len(64).map(|&i| (i, accel_of(i as usize))).collect()
     } else {
-        active.iter().map(|&i| (i, accel_of(i as usize))).collect()
+        queries.iter().map(|&i| (i, accel_of(i as usize))).collect()
     };
     for (i, a) in out {
         acc[i as usize] = a;
