@@ -1,1 +1,71 @@
-fn main(){}
+//! One physics frame (default dt, SPH, entrainment, detrainment, recycling,
+//! wind all on) with 12 to 10,000 parcels, and the projection into P.
+//! The domain keeps one parcel per km² (12 parcels: 3.5 km square; 10,000:
+//! 100 km), the parcels are spun up for 20 minutes first so they are
+//! released, rising and condensing.
+//!
+//! `cargo bench --bench physics`
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use cumulus::sim::{
+    Atmosphere, Band, ParametricProfile, PhysicsConfig, ProjectedField, Simulation,
+};
+
+fn spun_up(n: usize) -> Simulation {
+    let cfg = PhysicsConfig {
+        parcels: n,
+        domain_size_m: 1000.0 * (n as f64).sqrt(),
+        release_stagger_s: 600.0,
+        ..PhysicsConfig::default()
+    };
+    let mut sim = Simulation::new(
+        cfg,
+        Atmosphere::from_parametric(&ParametricProfile::FAIR_WEATHER),
+    );
+    for _ in 0..600 {
+        sim.step();
+    }
+    sim
+}
+
+const BAND: Band = Band {
+    bottom_m: 600.0,
+    top_m: 1600.0,
+};
+
+fn physics(c: &mut Criterion) {
+    let mut g = c.benchmark_group("step");
+    for n in [12, 100, 1000, 10_000] {
+        let mut sim = spun_up(n);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| sim.step())
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("project_128");
+    for n in [12, 1000, 10_000] {
+        let sim = spun_up(n);
+        let mut field = ProjectedField::new(128, 128);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| field.project(sim.parcels(), sim.config().domain_size_m, BAND, 0.08))
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("step_and_project_128");
+    let mut sim = spun_up(10_000);
+    let mut field = ProjectedField::new(128, 128);
+    g.bench_function("10000", |b| {
+        b.iter(|| {
+            sim.step();
+            field.project(sim.parcels(), sim.config().domain_size_m, BAND, 0.08)
+        })
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(3)).warm_up_time(std::time::Duration::from_secs(1));
+    targets = physics
+}
+criterion_main!(benches);

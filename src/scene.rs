@@ -13,11 +13,24 @@ use crate::sim::{Atmosphere, Band, ParametricProfile, PhysicsConfig, Sounding, S
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     #[error("{path}: cannot read scene: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path}:{line}:{column}: {message}")]
-    Parse { path: PathBuf, line: usize, column: usize, message: String },
+    Parse {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
     #[error("{path}{}: `{key}`: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
-    Invalid { path: PathBuf, line: Option<usize>, key: String, message: String },
+    Invalid {
+        path: PathBuf,
+        line: Option<usize>,
+        key: String,
+        message: String,
+    },
     #[error(transparent)]
     Sounding(#[from] SoundingError),
 }
@@ -52,7 +65,12 @@ pub struct ProjectionSection {
 
 impl Default for ProjectionSection {
     fn default() -> Self {
-        Self { width: 128, height: 128, band_bottom_m: None, band_top_m: None }
+        Self {
+            width: 128,
+            height: 128,
+            band_bottom_m: None,
+            band_top_m: None,
+        }
     }
 }
 
@@ -85,8 +103,10 @@ struct Check<'a> {
 impl Scene {
     /// Reads, parses and validates a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
         Self::parse(&text, path)
     }
 
@@ -94,10 +114,7 @@ impl Scene {
     /// anchors relative sounding paths.
     pub fn parse(text: &str, path: &Path) -> Result<Self, SceneError> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| {
-            let (line, column) = e
-                .span()
-                .map(|s| line_col(text, s.start))
-                .unwrap_or((1, 1));
+            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
             SceneError::Parse {
                 path: path.to_owned(),
                 line,
@@ -115,60 +132,303 @@ impl Scene {
     /// when the scene came from a file, the line.
     pub fn validate(&self) -> Result<(), SceneError> {
         let p = &self.physics;
-        let c = |key, ok, expected, value: f64| Check { key, ok, expected, value: value.to_string() };
+        let c = |key, ok, expected, value: f64| Check {
+            key,
+            ok,
+            expected,
+            value: value.to_string(),
+        };
         let finite_in = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
         let mut checks = vec![
-            c("physics.dt_s", finite_in(p.dt_s, 1e-3, 600.0), "1e-3..=600 s", p.dt_s),
-            c("physics.parcels", p.parcels <= 200_000, "0..=200000", p.parcels as f64),
-            c("physics.domain_size_m", finite_in(p.domain_size_m, 1.0, 1e7), "1..=1e7 m", p.domain_size_m),
-            c("physics.radius_m", finite_in(p.radius_m, 1e-3, 1e5) , "a radius > 0 m", p.radius_m),
-            c("physics.radius_jitter", finite_in(p.radius_jitter, 0.0, 0.99), "0..<1", p.radius_jitter),
-            c("physics.release_height_m", finite_in(p.release_height_m, 0.0, 1e5), ">= 0 m", p.release_height_m),
-            c("physics.release_stagger_s", finite_in(p.release_stagger_s, 0.0, 1e7), ">= 0 s", p.release_stagger_s),
-            c("physics.initial_excess_k", finite_in(p.initial_excess_k, -50.0, 50.0), "-50..=50 K", p.initial_excess_k),
-            c("physics.initial_excess_qt_gkg", finite_in(p.initial_excess_qt_gkg, -50.0, 50.0), "-50..=50 g/kg", p.initial_excess_qt_gkg),
-            c("physics.virtual_mass", finite_in(p.virtual_mass, 0.0, 2.0), "0..=2", p.virtual_mass),
-            c("physics.drag_coefficient", finite_in(p.drag_coefficient, 0.0, 5.0), "0..=5", p.drag_coefficient),
-            c("physics.fill_full_condensed_fraction", finite_in(p.fill_full_condensed_fraction, 1e-6, 1.0), "(0, 1]", p.fill_full_condensed_fraction),
-            c("physics.entrainment.coefficient", finite_in(p.entrainment.coefficient, 0.0, 2.0), "0..=2", p.entrainment.coefficient),
-            c("physics.detrainment.rate_per_s", finite_in(p.detrainment.rate_per_s, 0.0, 1.0), "0..=1 1/s", p.detrainment.rate_per_s),
-            c("physics.detrainment.sorting_factor", finite_in(p.detrainment.sorting_factor, 0.0, 100.0), "0..=100", p.detrainment.sorting_factor),
-            c("physics.recycling.spent_fraction_of_peak", finite_in(p.recycling.spent_fraction_of_peak, 0.0, 1.0), "0..=1", p.recycling.spent_fraction_of_peak),
-            c("physics.recycling.max_age_s", finite_in(p.recycling.max_age_s, 1e-3, 1e9), "> 0 s", p.recycling.max_age_s),
-            c("physics.sph.smoothing_radii", finite_in(p.sph.smoothing_radii, 1e-3, 100.0) && (!p.sph.enabled || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m), "> 0, with smoothing_radii * radius_m <= domain_size_m / 2", p.sph.smoothing_radii),
-            c("physics.sph.sound_speed_mps", finite_in(p.sph.sound_speed_mps, 1e-6, 1e3), "> 0 m/s", p.sph.sound_speed_mps),
-            c("physics.sph.viscosity_m2ps", finite_in(p.sph.viscosity_m2ps, 0.0, 1e7), ">= 0 m²/s", p.sph.viscosity_m2ps),
-            c("physics.wind.speed_mps", finite_in(p.wind.speed_mps, 0.0, 200.0), "0..=200 m/s", p.wind.speed_mps),
-            c("physics.wind.direction_deg", p.wind.direction_deg.is_finite(), "a finite angle", p.wind.direction_deg),
-            c("physics.wind.shear_per_km", finite_in(p.wind.shear_per_km, -1.0, 10.0), "-1..=10 1/km", p.wind.shear_per_km),
-            c("physics.substeps.max_buoyancy_phase", finite_in(p.substeps.max_buoyancy_phase, 1e-6, 1.0), "(0, 1]", p.substeps.max_buoyancy_phase),
-            c("physics.substeps.max_rise_m", finite_in(p.substeps.max_rise_m, 1e-3, 1e5), "> 0 m", p.substeps.max_rise_m),
-            c("physics.substeps.sph_courant", finite_in(p.substeps.sph_courant, 1e-6, 1.0), "(0, 1]", p.substeps.sph_courant),
-            c("physics.substeps.max_per_frame", (1..=1_000_000).contains(&p.substeps.max_per_frame), "1..=1000000", p.substeps.max_per_frame as f64),
-            c("projection.width", (1..=4096).contains(&self.projection.width), "1..=4096 texels", self.projection.width as f64),
-            c("projection.height", (1..=4096).contains(&self.projection.height), "1..=4096 texels", self.projection.height as f64),
+            c(
+                "physics.dt_s",
+                finite_in(p.dt_s, 1e-3, 600.0),
+                "1e-3..=600 s",
+                p.dt_s,
+            ),
+            c(
+                "physics.parcels",
+                p.parcels <= 200_000,
+                "0..=200000",
+                p.parcels as f64,
+            ),
+            c(
+                "physics.domain_size_m",
+                finite_in(p.domain_size_m, 1.0, 1e7),
+                "1..=1e7 m",
+                p.domain_size_m,
+            ),
+            c(
+                "physics.radius_m",
+                finite_in(p.radius_m, 1e-3, 1e5),
+                "a radius > 0 m",
+                p.radius_m,
+            ),
+            c(
+                "physics.radius_jitter",
+                finite_in(p.radius_jitter, 0.0, 0.99),
+                "0..<1",
+                p.radius_jitter,
+            ),
+            c(
+                "physics.release_height_m",
+                finite_in(p.release_height_m, 0.0, 1e5),
+                ">= 0 m",
+                p.release_height_m,
+            ),
+            c(
+                "physics.release_stagger_s",
+                finite_in(p.release_stagger_s, 0.0, 1e7),
+                ">= 0 s",
+                p.release_stagger_s,
+            ),
+            c(
+                "physics.initial_excess_k",
+                finite_in(p.initial_excess_k, -50.0, 50.0),
+                "-50..=50 K",
+                p.initial_excess_k,
+            ),
+            c(
+                "physics.initial_excess_qt_gkg",
+                finite_in(p.initial_excess_qt_gkg, -50.0, 50.0),
+                "-50..=50 g/kg",
+                p.initial_excess_qt_gkg,
+            ),
+            c(
+                "physics.virtual_mass",
+                finite_in(p.virtual_mass, 0.0, 2.0),
+                "0..=2",
+                p.virtual_mass,
+            ),
+            c(
+                "physics.drag_coefficient",
+                finite_in(p.drag_coefficient, 0.0, 5.0),
+                "0..=5",
+                p.drag_coefficient,
+            ),
+            c(
+                "physics.fill_full_condensed_fraction",
+                finite_in(p.fill_full_condensed_fraction, 1e-6, 1.0),
+                "(0, 1]",
+                p.fill_full_condensed_fraction,
+            ),
+            c(
+                "physics.entrainment.coefficient",
+                finite_in(p.entrainment.coefficient, 0.0, 2.0),
+                "0..=2",
+                p.entrainment.coefficient,
+            ),
+            c(
+                "physics.detrainment.rate_per_s",
+                finite_in(p.detrainment.rate_per_s, 0.0, 1.0),
+                "0..=1 1/s",
+                p.detrainment.rate_per_s,
+            ),
+            c(
+                "physics.detrainment.sorting_factor",
+                finite_in(p.detrainment.sorting_factor, 0.0, 100.0),
+                "0..=100",
+                p.detrainment.sorting_factor,
+            ),
+            c(
+                "physics.recycling.spent_fraction_of_peak",
+                finite_in(p.recycling.spent_fraction_of_peak, 0.0, 1.0),
+                "0..=1",
+                p.recycling.spent_fraction_of_peak,
+            ),
+            c(
+                "physics.recycling.max_age_s",
+                finite_in(p.recycling.max_age_s, 1e-3, 1e9),
+                "> 0 s",
+                p.recycling.max_age_s,
+            ),
+            c(
+                "physics.sph.smoothing_radii",
+                finite_in(p.sph.smoothing_radii, 1e-3, 100.0)
+                    && (!p.sph.enabled
+                        || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m),
+                "> 0, with smoothing_radii * radius_m <= domain_size_m / 2",
+                p.sph.smoothing_radii,
+            ),
+            c(
+                "physics.sph.sound_speed_mps",
+                finite_in(p.sph.sound_speed_mps, 1e-6, 1e3),
+                "> 0 m/s",
+                p.sph.sound_speed_mps,
+            ),
+            c(
+                "physics.sph.viscosity_m2ps",
+                finite_in(p.sph.viscosity_m2ps, 0.0, 1e7),
+                ">= 0 m²/s",
+                p.sph.viscosity_m2ps,
+            ),
+            c(
+                "physics.wind.speed_mps",
+                finite_in(p.wind.speed_mps, 0.0, 200.0),
+                "0..=200 m/s",
+                p.wind.speed_mps,
+            ),
+            c(
+                "physics.wind.direction_deg",
+                p.wind.direction_deg.is_finite(),
+                "a finite angle",
+                p.wind.direction_deg,
+            ),
+            c(
+                "physics.wind.shear_per_km",
+                finite_in(p.wind.shear_per_km, -1.0, 10.0),
+                "-1..=10 1/km",
+                p.wind.shear_per_km,
+            ),
+            c(
+                "physics.substeps.max_buoyancy_phase",
+                finite_in(p.substeps.max_buoyancy_phase, 1e-6, 1.0),
+                "(0, 1]",
+                p.substeps.max_buoyancy_phase,
+            ),
+            c(
+                "physics.substeps.max_rise_m",
+                finite_in(p.substeps.max_rise_m, 1e-3, 1e5),
+                "> 0 m",
+                p.substeps.max_rise_m,
+            ),
+            c(
+                "physics.substeps.sph_courant",
+                finite_in(p.substeps.sph_courant, 1e-6, 1.0),
+                "(0, 1]",
+                p.substeps.sph_courant,
+            ),
+            c(
+                "physics.substeps.max_per_frame",
+                (1..=1_000_000).contains(&p.substeps.max_per_frame),
+                "1..=1000000",
+                p.substeps.max_per_frame as f64,
+            ),
+            c(
+                "projection.width",
+                (1..=4096).contains(&self.projection.width),
+                "1..=4096 texels",
+                self.projection.width as f64,
+            ),
+            c(
+                "projection.height",
+                (1..=4096).contains(&self.projection.height),
+                "1..=4096 texels",
+                self.projection.height as f64,
+            ),
         ];
-        let opt = |key, v: Option<f64>, lo, hi, expected| v.map(|v| c(key, finite_in(v, lo, hi), expected, v));
-        checks.extend(opt("atmosphere.surface_pressure_hpa", self.atmosphere.surface_pressure_hpa, 300.0, 1100.0, "300..=1100 hPa"));
-        checks.extend(opt("atmosphere.inversion_base_m", self.atmosphere.inversion_base_m, 0.0, 1e5, ">= 0 m"));
-        checks.extend(opt("projection.band_bottom_m", self.projection.band_bottom_m, 0.0, 1e5, ">= 0 m"));
-        checks.extend(opt("projection.band_top_m", self.projection.band_top_m, 0.0, 1e5, ">= 0 m and above band_bottom_m"));
+        let opt = |key, v: Option<f64>, lo, hi, expected| {
+            v.map(|v| c(key, finite_in(v, lo, hi), expected, v))
+        };
+        checks.extend(opt(
+            "atmosphere.surface_pressure_hpa",
+            self.atmosphere.surface_pressure_hpa,
+            300.0,
+            1100.0,
+            "300..=1100 hPa",
+        ));
+        checks.extend(opt(
+            "atmosphere.inversion_base_m",
+            self.atmosphere.inversion_base_m,
+            0.0,
+            1e5,
+            ">= 0 m",
+        ));
+        checks.extend(opt(
+            "projection.band_bottom_m",
+            self.projection.band_bottom_m,
+            0.0,
+            1e5,
+            ">= 0 m",
+        ));
+        checks.extend(opt(
+            "projection.band_top_m",
+            self.projection.band_top_m,
+            0.0,
+            1e5,
+            ">= 0 m and above band_bottom_m",
+        ));
         if let (Some(b), Some(t)) = (self.projection.band_bottom_m, self.projection.band_top_m) {
-            checks.push(Check { key: "projection.band_top_m", ok: t > b, expected: "above band_bottom_m", value: t.to_string() });
+            checks.push(Check {
+                key: "projection.band_top_m",
+                ok: t > b,
+                expected: "above band_bottom_m",
+                value: t.to_string(),
+            });
         }
         if let Some(pp) = &self.atmosphere.parametric {
             let k = "atmosphere.parametric.";
             let list = [
-                ("surface_temperature_k", pp.surface_temperature_k, 180.0, 340.0, "180..=340 K"),
-                ("surface_pressure_hpa", pp.surface_pressure_hpa, 300.0, 1100.0, "300..=1100 hPa"),
-                ("surface_relative_humidity", pp.surface_relative_humidity, 0.0, 1.2, "0..=1.2"),
-                ("lapse_rate_k_per_km", pp.lapse_rate_k_per_km, -20.0, 20.0, "-20..=20 K/km"),
-                ("inversion_base_m", pp.inversion_base_m, 0.0, 20_000.0, "0..=20000 m"),
-                ("inversion_thickness_m", pp.inversion_thickness_m, 1.0, 5000.0, "1..=5000 m"),
-                ("inversion_strength_k", pp.inversion_strength_k, 0.0, 40.0, "0..=40 K"),
-                ("lapse_rate_above_k_per_km", pp.lapse_rate_above_k_per_km, -20.0, 20.0, "-20..=20 K/km"),
-                ("humidity_scale_height_m", pp.humidity_scale_height_m, 1.0, 1e6, ">= 1 m"),
-                ("humidity_drop_above_inversion", pp.humidity_drop_above_inversion, 0.0, 1.0, "0..=1"),
+                (
+                    "surface_temperature_k",
+                    pp.surface_temperature_k,
+                    180.0,
+                    340.0,
+                    "180..=340 K",
+                ),
+                (
+                    "surface_pressure_hpa",
+                    pp.surface_pressure_hpa,
+                    300.0,
+                    1100.0,
+                    "300..=1100 hPa",
+                ),
+                (
+                    "surface_relative_humidity",
+                    pp.surface_relative_humidity,
+                    0.0,
+                    1.2,
+                    "0..=1.2",
+                ),
+                (
+                    "lapse_rate_k_per_km",
+                    pp.lapse_rate_k_per_km,
+                    -20.0,
+                    20.0,
+                    "-20..=20 K/km",
+                ),
+                (
+                    "inversion_base_m",
+                    pp.inversion_base_m,
+                    0.0,
+                    20_000.0,
+                    "0..=20000 m",
+                ),
+                (
+                    "inversion_thickness_m",
+                    pp.inversion_thickness_m,
+                    1.0,
+                    5000.0,
+                    "1..=5000 m",
+                ),
+                (
+                    "inversion_strength_k",
+                    pp.inversion_strength_k,
+                    0.0,
+                    40.0,
+                    "0..=40 K",
+                ),
+                (
+                    "lapse_rate_above_k_per_km",
+                    pp.lapse_rate_above_k_per_km,
+                    -20.0,
+                    20.0,
+                    "-20..=20 K/km",
+                ),
+                (
+                    "humidity_scale_height_m",
+                    pp.humidity_scale_height_m,
+                    1.0,
+                    1e6,
+                    ">= 1 m",
+                ),
+                (
+                    "humidity_drop_above_inversion",
+                    pp.humidity_drop_above_inversion,
+                    0.0,
+                    1.0,
+                    "0..=1",
+                ),
                 ("top_m", pp.top_m, 100.0, 30_000.0, "100..=30000 m"),
             ];
             for (name, v, lo, hi, expected) in list {
@@ -180,7 +440,12 @@ impl Scene {
                 });
             }
             if self.atmosphere.sounding.is_some() {
-                checks.push(Check { key: "atmosphere.sounding", ok: false, expected: "either a sounding or [atmosphere.parametric], not both", value: "both given".into() });
+                checks.push(Check {
+                    key: "atmosphere.sounding",
+                    ok: false,
+                    expected: "either a sounding or [atmosphere.parametric], not both",
+                    value: "both given".into(),
+                });
             }
         }
         match checks.into_iter().find(|c| !c.ok) {
@@ -192,7 +457,10 @@ impl Scene {
     /// An error about `key`, located in the scene text when there is one.
     pub fn invalid(&self, key: &str, message: String) -> SceneError {
         SceneError::Invalid {
-            path: self.source.clone().unwrap_or_else(|| PathBuf::from("<scene>")),
+            path: self
+                .source
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("<scene>")),
             line: self.text.as_deref().and_then(|t| locate_key(t, key)),
             key: key.to_owned(),
             message,
@@ -238,7 +506,10 @@ impl Scene {
             .band_top_m
             .or(atm.inversion_base_m().filter(|&z| z > bottom + 50.0))
             .unwrap_or(bottom + 1500.0);
-        Band { bottom_m: bottom, top_m: top.max(bottom + 1.0) }
+        Band {
+            bottom_m: bottom,
+            top_m: top.max(bottom + 1.0),
+        }
     }
 }
 
@@ -263,9 +534,14 @@ pub fn locate_key(text: &str, key: &str) -> Option<usize> {
             table = h.split('.').map(|s| s.trim().to_owned()).collect();
             continue;
         }
-        let Some((lhs, _)) = line.split_once('=') else { continue };
+        let Some((lhs, _)) = line.split_once('=') else {
+            continue;
+        };
         let mut full: Vec<String> = table.clone();
-        full.extend(lhs.split('.').map(|s| s.trim().trim_matches('"').to_owned()));
+        full.extend(
+            lhs.split('.')
+                .map(|s| s.trim().trim_matches('"').to_owned()),
+        );
         if full.len() == parts.len() && full.iter().zip(&parts).all(|(a, b)| a == b) {
             return Some(n + 1);
         }
@@ -288,13 +564,21 @@ mod tests {
 
     #[test]
     fn negative_radius_names_key_and_line() {
-        let e = Scene::parse("[physics]\nparcels = 3\nradius_m = -5\n", Path::new("s.toml")).expect_err("negative");
-        assert_eq!(e.to_string(), "s.toml:3: `physics.radius_m`: is -5, expected a radius > 0 m");
+        let e = Scene::parse(
+            "[physics]\nparcels = 3\nradius_m = -5\n",
+            Path::new("s.toml"),
+        )
+        .expect_err("negative");
+        assert_eq!(
+            e.to_string(),
+            "s.toml:3: `physics.radius_m`: is -5, expected a radius > 0 m"
+        );
     }
 
     #[test]
     fn unknown_key_names_line() {
-        let e = Scene::parse("[physics]\nparcels = 3\nradius = 5\n", Path::new("s.toml")).expect_err("unknown");
+        let e = Scene::parse("[physics]\nparcels = 3\nradius = 5\n", Path::new("s.toml"))
+            .expect_err("unknown");
         let msg = e.to_string();
         assert!(msg.starts_with("s.toml:3:"), "{msg}");
         assert!(msg.contains("unknown field `radius`"), "{msg}");

@@ -28,21 +28,40 @@ fn bomex_parcels_form_a_cloud_layer_between_500_and_2000_m() {
         let p = sim.parcels();
         // Cloud base: the lowest height at which any parcel holds condensate.
         // A parcel's centre is where its state is defined, so that is its z.
-        let cloudy: Vec<f64> = (0..p.len()).filter(|&i| p.diag[i].qc > 1e-5).map(|i| p.pos[i].z).collect();
-        if let (Some(lo), Some(hi)) = (cloudy.iter().copied().reduce(f64::min), cloudy.iter().copied().reduce(f64::max)) {
+        let cloudy: Vec<f64> = (0..p.len())
+            .filter(|&i| p.diag[i].qc > 1e-5)
+            .map(|i| p.pos[i].z)
+            .collect();
+        if let (Some(lo), Some(hi)) = (
+            cloudy.iter().copied().reduce(f64::min),
+            cloudy.iter().copied().reduce(f64::max),
+        ) {
             bases.push(lo);
             tops.push(hi);
         }
     }
-    assert!(bases.len() > 50, "clouds present most of the second hour ({} of 60 samples)", bases.len());
+    assert!(
+        bases.len() > 50,
+        "clouds present most of the second hour ({} of 60 samples)",
+        bases.len()
+    );
     bases.sort_by(f64::total_cmp);
     tops.sort_by(f64::total_cmp);
     let base = bases[bases.len() / 2];
     let top = tops[tops.len() / 2];
     let highest = tops[tops.len() - 1];
-    assert!((500.0..=700.0).contains(&base), "median cloud base {base:.0} m");
-    assert!(top > base + 500.0, "a cloud layer, not a film: median top {top:.0} m");
-    assert!(highest < 2000.0, "tops stay under the inversion: highest {highest:.0} m");
+    assert!(
+        (500.0..=700.0).contains(&base),
+        "median cloud base {base:.0} m"
+    );
+    assert!(
+        top > base + 500.0,
+        "a cloud layer, not a film: median top {top:.0} m"
+    );
+    assert!(
+        highest < 2000.0,
+        "tops stay under the inversion: highest {highest:.0} m"
+    );
     let b = sim.water_budget();
     assert!(b.relative_residual() < 1e-9, "water budget {b:?}");
 }

@@ -9,7 +9,14 @@ use glam::DVec3;
 /// Everything that mixes, drags, pushes or recycles switched off: a lone
 /// parcel under buoyancy alone.
 fn bare_physics(dt_s: f64) -> PhysicsConfig {
-    let mut c = PhysicsConfig { dt_s, virtual_mass: 0.0, drag_coefficient: 0.0, initial_excess_k: 0.0, initial_excess_qt_gkg: 0.0, ..PhysicsConfig::default() };
+    let mut c = PhysicsConfig {
+        dt_s,
+        virtual_mass: 0.0,
+        drag_coefficient: 0.0,
+        initial_excess_k: 0.0,
+        initial_excess_qt_gkg: 0.0,
+        ..PhysicsConfig::default()
+    };
     c.entrainment.enabled = false;
     c.detrainment.enabled = false;
     c.recycling.enabled = false;
@@ -34,7 +41,8 @@ fn dry_adiabatic_lift_conserves_theta_exactly() {
     // A warm dry bubble rising through a dry, neutral atmosphere: θ (= θ_l
     // when there is no condensate) is not touched by motion at all.
     let atm = stable_dry_layer(G / C_P * 1e3);
-    let mut sim = Simulation::with_positions(bare_physics(1.0), atm, &[DVec3::new(100.0, 100.0, 100.0)]);
+    let mut sim =
+        Simulation::with_positions(bare_physics(1.0), atm, &[DVec3::new(100.0, 100.0, 100.0)]);
     sim.set_parcel(0, DVec3::new(100.0, 100.0, 100.0), 3.0, 0.0);
     let env = sim.atmosphere().at(100.0);
     // θ = T / Π with the Π the parcel's temperature was made with.
@@ -45,16 +53,29 @@ fn dry_adiabatic_lift_conserves_theta_exactly() {
         sim.step();
     }
     let p = sim.parcels();
-    assert!(p.pos[0].z > 500.0, "the warm bubble rose: z = {}", p.pos[0].z);
+    assert!(
+        p.pos[0].z > 500.0,
+        "the warm bubble rose: z = {}",
+        p.pos[0].z
+    );
     let env = sim.atmosphere().at(p.pos[0].z);
     let theta = p.diag[0].t_k / env.exner;
-    assert_eq!(p.theta_l[0], theta_l0, "the prognostic θ is untouched by motion");
+    assert_eq!(
+        p.theta_l[0], theta_l0,
+        "the prognostic θ is untouched by motion"
+    );
     // Round-off of T = θ Π and back: 1e-12 relative.
-    assert!((theta - theta0).abs() < 1e-12 * theta0, "θ {theta} vs {theta0}");
+    assert!(
+        (theta - theta0).abs() < 1e-12 * theta0,
+        "θ {theta} vs {theta0}"
+    );
     // Against θ from the pressure itself, Π interpolated in the 1 m table
     // differs by < 1e-9 relative.
     let theta_p = potential_temperature(p.diag[0].t_k, env.p_pa);
-    assert!((theta_p - theta0).abs() < 1e-9 * theta0, "θ(p) {theta_p} vs {theta0}");
+    assert!(
+        (theta_p - theta0).abs() < 1e-9 * theta0,
+        "θ(p) {theta_p} vs {theta0}"
+    );
     assert_eq!(p.qt[0], qt0, "q_t conserved without mixing");
     assert_eq!(p.diag[0].qc, 0.0);
 }
@@ -62,7 +83,10 @@ fn dry_adiabatic_lift_conserves_theta_exactly() {
 #[test]
 fn total_water_is_conserved_without_mixing_through_condensation() {
     // A moist parcel rises through its LCL and condenses: q_t unchanged.
-    let atm = Atmosphere::from_parametric(&ParametricProfile { surface_relative_humidity: 0.9, ..ParametricProfile::FAIR_WEATHER });
+    let atm = Atmosphere::from_parametric(&ParametricProfile {
+        surface_relative_humidity: 0.9,
+        ..ParametricProfile::FAIR_WEATHER
+    });
     let mut sim = Simulation::with_positions(bare_physics(2.0), atm, &[DVec3::new(0.0, 0.0, 50.0)]);
     sim.set_parcel(0, DVec3::new(0.0, 0.0, 50.0), 1.0, 0.002);
     let qt0 = sim.parcels().qt[0];
@@ -107,10 +131,17 @@ fn brunt_vaisala_period_within_one_percent() {
     let n = atm.n_squared(z_eq).sqrt();
     let theta = atm.at(z_eq).theta_v;
     let dtheta_dz = (G / C_P - 4e-3) * theta / atm.at(z_eq).t_k;
-    assert!((n * n - G / theta * dtheta_dz).abs() / (n * n) < 0.01, "tabulated N² matches analytic");
+    assert!(
+        (n * n - G / theta * dtheta_dz).abs() / (n * n) < 0.01,
+        "tabulated N² matches analytic"
+    );
     let expected = 2.0 * std::f64::consts::PI / n;
     for dt in [1.0, 10.0] {
-        let mut sim = Simulation::with_positions(bare_physics(dt), atm.clone(), &[DVec3::new(0.0, 0.0, z_eq)]);
+        let mut sim = Simulation::with_positions(
+            bare_physics(dt),
+            atm.clone(),
+            &[DVec3::new(0.0, 0.0, z_eq)],
+        );
         // θ_l of the environment at z_eq, placed 10 m lower.
         let th_eq = atm.at(z_eq).theta_l;
         let th_low = atm.at(z_eq - 10.0).theta_l;
@@ -128,12 +159,18 @@ fn virtual_mass_lengthens_the_period_by_sqrt_one_plus_gamma() {
     let atm = stable_dry_layer(4.0);
     let z_eq = 1000.0;
     let expected = 2.0 * std::f64::consts::PI / atm.n_squared(z_eq).sqrt() * 1.5_f64.sqrt();
-    let cfg = PhysicsConfig { virtual_mass: 0.5, ..bare_physics(2.0) };
+    let cfg = PhysicsConfig {
+        virtual_mass: 0.5,
+        ..bare_physics(2.0)
+    };
     let mut sim = Simulation::with_positions(cfg, atm.clone(), &[DVec3::new(0.0, 0.0, z_eq)]);
     let d = atm.at(z_eq).theta_l - atm.at(z_eq - 10.0).theta_l;
     sim.set_parcel(0, DVec3::new(0.0, 0.0, z_eq - 10.0), d, 0.0);
     let period = measured_period(&mut sim, z_eq, (6.0 * expected / 2.0) as usize);
-    assert!((period - expected).abs() / expected < PERIOD_TOLERANCE, "{period} vs {expected}");
+    assert!(
+        (period - expected).abs() / expected < PERIOD_TOLERANCE,
+        "{period} vs {expected}"
+    );
 }
 
 #[test]
@@ -153,5 +190,8 @@ fn entrainment_relaxes_exactly_even_for_huge_steps() {
     let p = sim.parcels();
     let env = sim.atmosphere().at(p.pos[0].z);
     let excess = p.theta_l[0] - env.theta_l;
-    assert!((0.0..5.0).contains(&excess), "θ_l excess {excess} must shrink without changing sign");
+    assert!(
+        (0.0..5.0).contains(&excess),
+        "θ_l excess {excess} must shrink without changing sign"
+    );
 }

@@ -18,12 +18,21 @@ fn root() -> PathBuf {
 }
 
 fn sounding_path(name: &str) -> PathBuf {
-    if name == "bomex" { root().join("scenes/bomex_sounding.csv") } else { root().join(format!("tests/data/{name}.csv")) }
+    if name == "bomex" {
+        root().join("scenes/bomex_sounding.csv")
+    } else {
+        root().join(format!("tests/data/{name}.csv"))
+    }
 }
 
 fn read_reference(file: &str) -> Vec<Vec<String>> {
-    let text = std::fs::read_to_string(root().join("tests/reference").join(file)).expect("reference file is committed");
-    text.lines().filter(|l| !l.starts_with('#')).skip(1).map(|l| l.split(',').map(str::to_owned).collect()).collect()
+    let text = std::fs::read_to_string(root().join("tests/reference").join(file))
+        .expect("reference file is committed");
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect()
 }
 
 fn load(name: &str) -> Sounding {
@@ -35,13 +44,28 @@ fn lcl_matches_metpy_within_10_m() {
     let rows = read_reference("lcl.csv");
     assert_eq!(rows.len(), 4);
     for r in rows {
-        let (name, p_ref, t_ref, z_ref): (&str, f64, f64, f64) =
-            (&r[0], r[1].parse().unwrap(), r[2].parse().unwrap(), r[3].parse().unwrap());
+        let (name, p_ref, t_ref, z_ref): (&str, f64, f64, f64) = (
+            &r[0],
+            r[1].parse().unwrap(),
+            r[2].parse().unwrap(),
+            r[3].parse().unwrap(),
+        );
         let prof = lift_sounding(&load(name), Adiabat::Pseudo);
         let z = prof.lcl_height_m.expect("saturates");
-        assert!((z - z_ref).abs() < LCL_HEIGHT_TOLERANCE_M, "{name}: LCL {z:.1} m vs MetPy {z_ref:.1} m");
-        assert!((prof.lcl.pressure_pa / 100.0 - p_ref).abs() < 1.0, "{name}: {} hPa vs {p_ref}", prof.lcl.pressure_pa / 100.0);
-        assert!((prof.lcl.temperature_k - t_ref).abs() < 0.1, "{name}: {} K vs {t_ref}", prof.lcl.temperature_k);
+        assert!(
+            (z - z_ref).abs() < LCL_HEIGHT_TOLERANCE_M,
+            "{name}: LCL {z:.1} m vs MetPy {z_ref:.1} m"
+        );
+        assert!(
+            (prof.lcl.pressure_pa / 100.0 - p_ref).abs() < 1.0,
+            "{name}: {} hPa vs {p_ref}",
+            prof.lcl.pressure_pa / 100.0
+        );
+        assert!(
+            (prof.lcl.temperature_k - t_ref).abs() < 0.1,
+            "{name}: {} K vs {t_ref}",
+            prof.lcl.temperature_k
+        );
     }
 }
 
@@ -50,15 +74,26 @@ fn pseudo_adiabat_matches_metpy_within_0_2_k_up_to_3_km_above_lcl() {
     let lcl = read_reference("lcl.csv");
     let rows = read_reference("parcel_profile.csv");
     let mut checked = 0;
-    for name in ["bomex", "continental_summer", "tropical_humid", "cool_maritime"] {
-        let z_lcl: f64 = lcl.iter().find(|r| r[0] == name).expect("listed")[3].parse().unwrap();
+    for name in [
+        "bomex",
+        "continental_summer",
+        "tropical_humid",
+        "cool_maritime",
+    ] {
+        let z_lcl: f64 = lcl.iter().find(|r| r[0] == name).expect("listed")[3]
+            .parse()
+            .unwrap();
         let prof = lift_sounding(&load(name), Adiabat::Pseudo);
         for r in rows.iter().filter(|r| r[0] == name) {
             let (z, t_ref): (f64, f64) = (r[1].parse().unwrap(), r[3].parse().unwrap());
             if z > z_lcl + 3000.0 {
                 continue;
             }
-            let row = prof.rows.iter().find(|p| (p.height_m - z).abs() < 1e-6).expect("same levels");
+            let row = prof
+                .rows
+                .iter()
+                .find(|p| (p.height_m - z).abs() < 1e-6)
+                .expect("same levels");
             assert!(
                 (row.parcel_t_k - t_ref).abs() < MOIST_ADIABAT_TOLERANCE_K,
                 "{name} at {z} m: {:.3} K vs MetPy {t_ref:.3} K",
@@ -78,7 +113,11 @@ fn hydrostatic_fill_matches_metpy_hypsometric_pressures() {
     let rows = read_reference("parcel_profile.csv");
     for r in rows.iter().filter(|r| r[0] == "cool_maritime") {
         let (z, p_ref): (f64, f64) = (r[1].parse().unwrap(), r[2].parse().unwrap());
-        let l = s.levels().iter().find(|l| (l.height_m - z).abs() < 1e-6).expect("same levels");
+        let l = s
+            .levels()
+            .iter()
+            .find(|l| (l.height_m - z).abs() < 1e-6)
+            .expect("same levels");
         let p = l.pressure_pa.expect("filled") / 100.0;
         // 0.05 hPa ≈ 0.5 m of height: far inside the LCL tolerance.
         assert!((p - p_ref).abs() < 0.05, "{z} m: {p} hPa vs {p_ref}");

@@ -30,14 +30,27 @@ fn atmosphere(rh: f64, inversion_k: f64) -> Atmosphere {
 }
 
 fn build(layout: Layout, dt: f64, atm: Atmosphere) -> Simulation {
-    let cfg = PhysicsConfig { dt_s: dt, release_stagger_s: 0.0, ..PhysicsConfig::default() };
+    let cfg = PhysicsConfig {
+        dt_s: dt,
+        release_stagger_s: 0.0,
+        ..PhysicsConfig::default()
+    };
     let l = cfg.domain_size_m;
     match layout {
         // 10,000 parcels over 100 km keep the default scene's ~1 parcel per
         // km²; the packed case is `ten_thousand_packed_parcels_stay_finite`.
-        Layout::Count(n) if n > 1000 => Simulation::new(PhysicsConfig { parcels: n, domain_size_m: 100_000.0, ..cfg }, atm),
+        Layout::Count(n) if n > 1000 => Simulation::new(
+            PhysicsConfig {
+                parcels: n,
+                domain_size_m: 100_000.0,
+                ..cfg
+            },
+            atm,
+        ),
         Layout::Count(n) => Simulation::new(PhysicsConfig { parcels: n, ..cfg }, atm),
-        Layout::OnePoint => Simulation::with_positions(cfg, atm, &vec![DVec3::new(5000.0, 5000.0, 50.0); 200]),
+        Layout::OnePoint => {
+            Simulation::with_positions(cfg, atm, &vec![DVec3::new(5000.0, 5000.0, 50.0); 200])
+        }
         Layout::Edges => {
             let e = 1e-9;
             let pts = [
@@ -64,18 +77,34 @@ fn check(sim: &Simulation, n: usize, what: &str) {
             && p.vel[i].is_finite()
             && p.theta_l[i].is_finite()
             && p.qt[i].is_finite()
-            && [d.t_k, d.qv, d.qc, d.theta_v, d.theta_v_env, d.buoyancy].iter().all(|x| x.is_finite())
+            && [d.t_k, d.qv, d.qc, d.theta_v, d.theta_v_env, d.buoyancy]
+                .iter()
+                .all(|x| x.is_finite())
             && d.qc >= 0.0
             && d.qv >= 0.0;
-        assert!(ok, "{what}: parcel {i} not finite: pos {:?} vel {:?} {d:?}", p.pos[i], p.vel[i]);
+        assert!(
+            ok,
+            "{what}: parcel {i} not finite: pos {:?} vel {:?} {d:?}",
+            p.pos[i], p.vel[i]
+        );
     }
     let b = sim.water_budget();
-    assert!(b.relative_residual() < BUDGET_TOLERANCE, "{what}: water budget {b:?}");
+    assert!(
+        b.relative_residual() < BUDGET_TOLERANCE,
+        "{what}: water budget {b:?}"
+    );
 }
 
 #[test]
 fn stability_matrix_stays_finite_and_closes_the_water_budget() {
-    let layouts = [Layout::Count(0), Layout::Count(1), Layout::Count(12), Layout::Count(10_000), Layout::OnePoint, Layout::Edges];
+    let layouts = [
+        Layout::Count(0),
+        Layout::Count(1),
+        Layout::Count(12),
+        Layout::Count(10_000),
+        Layout::OnePoint,
+        Layout::Edges,
+    ];
     for rh in RHS {
         for inv in INVERSIONS {
             let atm = atmosphere(rh, inv);
@@ -85,11 +114,19 @@ fn stability_matrix_stays_finite_and_closes_the_water_budget() {
                     let n = sim.parcels().len();
                     // Three frames: at 600 s that is half an hour of cloud
                     // life; at 1 ms it is the start-up transient.
-                    let frames = if matches!(layout, Layout::Count(10_000)) && dt < 10.0 { 1 } else { 3 };
+                    let frames = if matches!(layout, Layout::Count(10_000)) && dt < 10.0 {
+                        1
+                    } else {
+                        3
+                    };
                     for _ in 0..frames {
                         sim.step();
                     }
-                    check(&sim, n, &format!("rh {rh}, inversion {inv} K, dt {dt} s, {layout:?}"));
+                    check(
+                        &sim,
+                        n,
+                        &format!("rh {rh}, inversion {inv} K, dt {dt} s, {layout:?}"),
+                    );
                 }
             }
         }
@@ -99,7 +136,11 @@ fn stability_matrix_stays_finite_and_closes_the_water_budget() {
 #[test]
 fn a_day_of_simulated_time_keeps_parcels_and_stays_finite() {
     let atm = atmosphere(0.8, 5.0);
-    let cfg = PhysicsConfig { parcels: 24, dt_s: 10.0, ..PhysicsConfig::default() };
+    let cfg = PhysicsConfig {
+        parcels: 24,
+        dt_s: 10.0,
+        ..PhysicsConfig::default()
+    };
     let mut sim = Simulation::new(cfg, atm);
     let frames = (24.0 * 3600.0 / 10.0) as usize;
     for _ in 0..frames {
@@ -107,7 +148,11 @@ fn a_day_of_simulated_time_keeps_parcels_and_stays_finite() {
     }
     check(&sim, 24, "24 h");
     assert!((sim.time_s() - 86_400.0).abs() < 1e-6);
-    assert!(sim.totals().recycled > 24, "parcels were re-born, the animation went on: {:?}", sim.totals());
+    assert!(
+        sim.totals().recycled > 24,
+        "parcels were re-born, the animation went on: {:?}",
+        sim.totals()
+    );
     assert_eq!(sim.totals().capped_frames, 0);
 }
 
@@ -115,7 +160,12 @@ fn a_day_of_simulated_time_keeps_parcels_and_stays_finite() {
 fn ten_thousand_packed_parcels_stay_finite() {
     // 10,000 parcels of 300 m in a 10 km square overlap ~100-fold: the SPH
     // pressure is at its stiffest and the sub-step bounds must hold it.
-    let cfg = PhysicsConfig { parcels: 10_000, dt_s: 60.0, release_stagger_s: 0.0, ..PhysicsConfig::default() };
+    let cfg = PhysicsConfig {
+        parcels: 10_000,
+        dt_s: 60.0,
+        release_stagger_s: 0.0,
+        ..PhysicsConfig::default()
+    };
     let mut sim = Simulation::new(cfg, atmosphere(1.2, 20.0));
     sim.step();
     check(&sim, 10_000, "10,000 packed parcels");
@@ -133,7 +183,11 @@ fn coincident_parcels_stay_finite_for_an_hour_at_large_steps() {
 #[test]
 fn identical_seeds_give_identical_runs_and_seeds_differ() {
     let run = |seed: u64| {
-        let cfg = PhysicsConfig { parcels: 2000, seed, ..PhysicsConfig::default() };
+        let cfg = PhysicsConfig {
+            parcels: 2000,
+            seed,
+            ..PhysicsConfig::default()
+        };
         let mut sim = Simulation::new(cfg, atmosphere(0.8, 5.0));
         for _ in 0..600 {
             sim.step();

@@ -15,7 +15,11 @@ use cumulus::sim::lift::{Adiabat, lift_sounding};
 use cumulus::sim::{Simulation, Sounding};
 
 #[derive(Parser)]
-#[command(name = "cumulus", version, about = "Physics-driven cumulus clouds (Goswami, STAG 2019): parcel simulator and tools")]
+#[command(
+    name = "cumulus",
+    version,
+    about = "Physics-driven cumulus clouds (Goswami, STAG 2019): parcel simulator and tools"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -117,14 +121,20 @@ fn run(cli: Cli) -> Result<()> {
         Command::Simulate(a) => simulate(a),
         Command::Profile(a) => profile(a),
         Command::Convergence(a) => convergence_cmd(a),
-        Command::Scene { command: SceneCommand::Check { file } } => {
+        Command::Scene {
+            command: SceneCommand::Check { file },
+        } => {
             let scene = Scene::load(&file)?;
             let atm = scene.atmosphere(None)?;
             let band = scene.band(&atm);
             println!(
                 "{}: ok ({}; {} parcels, dt {} s, cloud band {:.0}-{:.0} m)",
                 file.display(),
-                if scene.name.is_empty() { "unnamed" } else { &scene.name },
+                if scene.name.is_empty() {
+                    "unnamed"
+                } else {
+                    &scene.name
+                },
                 scene.physics.parcels,
                 scene.physics.dt_s,
                 band.bottom_m,
@@ -138,7 +148,11 @@ fn run(cli: Cli) -> Result<()> {
 fn progress_bar(len: u64, what: &str) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(
         Some(len),
-        if std::io::stderr().is_terminal() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
+        if std::io::stderr().is_terminal() {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        },
     );
     bar.set_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
@@ -171,7 +185,9 @@ fn simulate(a: SimulateArgs) -> Result<()> {
     if let Some(s) = a.seed {
         scene.physics.seed = s;
     }
-    scene.validate().context("after applying --dt-s/--parcels/--seed")?;
+    scene
+        .validate()
+        .context("after applying --dt-s/--parcels/--seed")?;
     finite_positive("--duration-s", a.duration_s)?;
     let every = a.every_s.unwrap_or(scene.physics.dt_s);
     finite_positive("--every-s", every)?;
@@ -213,7 +229,10 @@ fn simulate(a: SimulateArgs) -> Result<()> {
 
 fn profile(a: ProfileArgs) -> Result<()> {
     if !(300.0..=1100.0).contains(&a.surface_pressure_hpa) {
-        bail!("--surface-pressure-hpa is {}, expected 300..=1100", a.surface_pressure_hpa);
+        bail!(
+            "--surface-pressure-hpa is {}, expected 300..=1100",
+            a.surface_pressure_hpa
+        );
     }
     let s = Sounding::load(&a.sounding, a.surface_pressure_hpa * 100.0)?;
     let prof = lift_sounding(&s, a.adiabat);
@@ -225,7 +244,10 @@ fn profile(a: ProfileArgs) -> Result<()> {
     }
     if let Some(out) = &a.out {
         write_atomically(out, |w| {
-            writeln!(w, "height_m,pressure_hPa,env_T_K,parcel_T_K,parcel_qv_gkg,parcel_qc_gkg,buoyancy_mps2")?;
+            writeln!(
+                w,
+                "height_m,pressure_hPa,env_T_K,parcel_T_K,parcel_qv_gkg,parcel_qc_gkg,buoyancy_mps2"
+            )?;
             for r in &prof.rows {
                 writeln!(
                     w,
@@ -249,21 +271,39 @@ fn profile(a: ProfileArgs) -> Result<()> {
 fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
     let scene = load_scene(&a.scene)?;
     if !(a.duration_s >= convergence::COMPARE_EVERY_S && a.duration_s.is_finite()) {
-        bail!("--duration-s is {}, expected at least {} s", a.duration_s, convergence::COMPARE_EVERY_S);
+        bail!(
+            "--duration-s is {}, expected at least {} s",
+            a.duration_s,
+            convergence::COMPARE_EVERY_S
+        );
     }
     let atm = scene.atmosphere(None)?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
     let dts = convergence::DEFAULT_DTS_S;
     let bar = progress_bar(dts.len() as u64 + 1, "convergence");
     let report = convergence::measure(&scene.physics, &atm, a.duration_s, &dts, || bar.inc(1));
     bar.finish_and_clear();
     convergence::write(&report, &a.out)?;
-    println!("reference dt {} s took {:.2} s", report.reference_dt_s, report.reference_wall_s);
-    println!("{:>8} {:>9} {:>9} {:>9} {:>10} {:>10} {:>9} {:>9}", "dt_s", "wall_s", "err_z_m", "err_w", "err_thv_K", "err_qc_gkg", "base_m", "top_m");
+    println!(
+        "reference dt {} s took {:.2} s",
+        report.reference_dt_s, report.reference_wall_s
+    );
+    println!(
+        "{:>8} {:>9} {:>9} {:>9} {:>10} {:>10} {:>9} {:>9}",
+        "dt_s", "wall_s", "err_z_m", "err_w", "err_thv_K", "err_qc_gkg", "base_m", "top_m"
+    );
     for r in &report.rows {
         println!(
             "{:>8} {:>9.4} {:>9.3} {:>9.4} {:>10.4} {:>10.5} {:>9.2} {:>9.2}",
-            r.dt_s, r.wall_s, r.err_z_m, r.err_w_mps, r.err_theta_v_k, r.err_qc_gkg, r.err_cloud_base_m, r.err_cloud_top_m
+            r.dt_s,
+            r.wall_s,
+            r.err_z_m,
+            r.err_w_mps,
+            r.err_theta_v_k,
+            r.err_qc_gkg,
+            r.err_cloud_base_m,
+            r.err_cloud_top_m
         );
     }
     match report.chosen {
@@ -273,8 +313,15 @@ fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
             convergence::TARGET_QC_GKG,
             report.rows[i].dt_s
         ),
-        None => println!("no step reached the stated error (z <= {} m, q_c <= {} g/kg)", convergence::TARGET_Z_M, convergence::TARGET_QC_GKG),
+        None => println!(
+            "no step reached the stated error (z <= {} m, q_c <= {} g/kg)",
+            convergence::TARGET_Z_M,
+            convergence::TARGET_QC_GKG
+        ),
     }
-    println!("wrote {0}/convergence.csv and {0}/convergence.png", a.out.display());
+    println!(
+        "wrote {0}/convergence.csv and {0}/convergence.png",
+        a.out.display()
+    );
     Ok(())
 }

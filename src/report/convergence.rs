@@ -11,7 +11,9 @@ use crate::io::write_atomically;
 use crate::sim::{Atmosphere, PhysicsConfig, Simulation};
 
 /// Frame steps measured by default, s. Each divides [`COMPARE_EVERY_S`].
-pub const DEFAULT_DTS_S: [f64; 12] = [0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 60.0, 120.0, 300.0, 600.0];
+pub const DEFAULT_DTS_S: [f64; 12] = [
+    0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 60.0, 120.0, 300.0, 600.0,
+];
 /// Step of the reference run, s.
 pub const REFERENCE_DT_S: f64 = 0.05;
 /// States are compared every this many simulated seconds.
@@ -57,7 +59,12 @@ struct Snapshot {
     base_top: Option<(f64, f64)>,
 }
 
-fn run(cfg: &PhysicsConfig, atm: &Atmosphere, dt: f64, duration_s: f64) -> (Vec<Snapshot>, f64, u64, u64) {
+fn run(
+    cfg: &PhysicsConfig,
+    atm: &Atmosphere,
+    dt: f64,
+    duration_s: f64,
+) -> (Vec<Snapshot>, f64, u64, u64) {
     let mut cfg = cfg.clone();
     cfg.dt_s = dt;
     let start = Instant::now();
@@ -70,19 +77,30 @@ fn run(cfg: &PhysicsConfig, atm: &Atmosphere, dt: f64, duration_s: f64) -> (Vec<
             sim.step();
         }
         let p = sim.parcels();
-        let cloudy: Vec<f64> = (0..p.len()).filter(|&i| p.diag[i].qc > 0.0 && p.life[i].released()).map(|i| p.pos[i].z).collect();
+        let cloudy: Vec<f64> = (0..p.len())
+            .filter(|&i| p.diag[i].qc > 0.0 && p.life[i].released())
+            .map(|i| p.pos[i].z)
+            .collect();
         out.push(Snapshot {
             z: p.pos.iter().map(|x| x.z).collect(),
             w: p.vel.iter().map(|v| v.z).collect(),
             theta_v: p.diag.iter().map(|d| d.theta_v).collect(),
             qc: p.diag.iter().map(|d| d.qc * 1e3).collect(),
             base_top: (!cloudy.is_empty()).then(|| {
-                (cloudy.iter().copied().fold(f64::MAX, f64::min), cloudy.iter().copied().fold(f64::MIN, f64::max))
+                (
+                    cloudy.iter().copied().fold(f64::MAX, f64::min),
+                    cloudy.iter().copied().fold(f64::MIN, f64::max),
+                )
             }),
         });
     }
     let t = sim.totals();
-    (out, start.elapsed().as_secs_f64(), t.substeps, t.capped_frames)
+    (
+        out,
+        start.elapsed().as_secs_f64(),
+        t.substeps,
+        t.capped_frames,
+    )
 }
 
 fn rms(a: &[Snapshot], b: &[Snapshot], f: impl Fn(&Snapshot) -> &Vec<f64>) -> f64 {
@@ -102,7 +120,11 @@ fn mean_abs(a: &[Snapshot], b: &[Snapshot], f: impl Fn((f64, f64)) -> f64) -> f6
         .zip(b)
         .filter_map(|(x, y)| Some((f(x.base_top?) - f(y.base_top?)).abs()))
         .collect();
-    if diffs.is_empty() { 0.0 } else { diffs.iter().sum::<f64>() / diffs.len() as f64 }
+    if diffs.is_empty() {
+        0.0
+    } else {
+        diffs.iter().sum::<f64>() / diffs.len() as f64
+    }
 }
 
 /// Measures every step in `dts_s` against the reference; `progress` is
@@ -139,7 +161,13 @@ pub fn measure(
         .filter(|(_, r)| r.err_z_m <= TARGET_Z_M && r.err_qc_gkg <= TARGET_QC_GKG)
         .min_by(|a, b| a.1.wall_s.total_cmp(&b.1.wall_s))
         .map(|(i, _)| i);
-    Report { reference_dt_s: REFERENCE_DT_S, reference_wall_s, duration_s, rows, chosen }
+    Report {
+        reference_dt_s: REFERENCE_DT_S,
+        reference_wall_s,
+        duration_s,
+        rows,
+        chosen,
+    }
 }
 
 /// Writes `convergence.csv` and `convergence.png` into `dir`.
@@ -161,18 +189,29 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     let floor = 1e-6;
     let series = |name: &str, f: fn(&Row) -> f64| Series {
         name: name.to_owned(),
-        points: report.rows.iter().map(|r| (r.wall_s.max(1e-6), f(r).max(floor))).collect(),
+        points: report
+            .rows
+            .iter()
+            .map(|r| (r.wall_s.max(1e-6), f(r).max(floor)))
+            .collect(),
     };
     let marked: Vec<(f64, f64, String)> = report
         .chosen
         .map(|i| {
             let r = &report.rows[i];
-            vec![(r.wall_s.max(1e-6), r.err_z_m.max(floor), format!("  default dt = {} s", r.dt_s))]
+            vec![(
+                r.wall_s.max(1e-6),
+                r.err_z_m.max(floor),
+                format!("  default dt = {} s", r.dt_s),
+            )]
         })
         .unwrap_or_default();
     loglog_png(
         &dir.join("convergence.png"),
-        &format!("Physics error against run time ({} s simulated, reference dt {} s)", report.duration_s, report.reference_dt_s),
+        &format!(
+            "Physics error against run time ({} s simulated, reference dt {} s)",
+            report.duration_s, report.reference_dt_s
+        ),
         "wall time of the run, s",
         "RMS error vs reference",
         &[

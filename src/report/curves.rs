@@ -7,8 +7,25 @@ use crate::sim::{Band, Simulation};
 
 /// The CSV header (units in the names).
 pub const HEADER: [&str; 19] = [
-    "t_s", "id", "generation", "age_s", "x_m", "y_m", "z_m", "w_mps", "theta_v_K", "theta_v_env_K", "T_K",
-    "qv_gkg", "qc_gkg", "qt_gkg", "buoyancy_mps2", "condensed_fraction", "fill", "z_norm", "coverage",
+    "t_s",
+    "id",
+    "generation",
+    "age_s",
+    "x_m",
+    "y_m",
+    "z_m",
+    "w_mps",
+    "theta_v_K",
+    "theta_v_env_K",
+    "T_K",
+    "qv_gkg",
+    "qc_gkg",
+    "qt_gkg",
+    "buoyancy_mps2",
+    "condensed_fraction",
+    "fill",
+    "z_norm",
+    "coverage",
 ];
 
 /// Writes the header.
@@ -19,7 +36,11 @@ pub fn write_header(out: &mut csv::Writer<impl Write>) -> csv::Result<()> {
 /// Writes one row per parcel at the simulation's current time. `fill` is the
 /// value the parcel projects into P; `coverage` is 1 for a condensed,
 /// released parcel (it projects), else 0.
-pub fn write_rows(out: &mut csv::Writer<impl Write>, sim: &Simulation, band: Band) -> csv::Result<()> {
+pub fn write_rows(
+    out: &mut csv::Writer<impl Write>,
+    sim: &Simulation,
+    band: Band,
+) -> csv::Result<()> {
     let p = sim.parcels();
     let full = sim.config().fill_full_condensed_fraction;
     let t = sim.time_s();
@@ -30,7 +51,11 @@ pub fn write_rows(out: &mut csv::Writer<impl Write>, sim: &Simulation, band: Ban
         let qt = p.qt[i];
         let cf = if qt > 0.0 { d.qc / qt } else { 0.0 };
         let projects = d.qc > 0.0 && l.released();
-        let fill = if projects { (cf / full).clamp(0.0, 1.0) } else { 0.0 };
+        let fill = if projects {
+            (cf / full).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         let pos = p.pos[i];
         out.write_record(&[
             fmt(t),

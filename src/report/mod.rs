@@ -9,7 +9,13 @@ pub mod plot;
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
     #[error("{path}: cannot write: {source}")]
-    Write { path: std::path::PathBuf, source: std::io::Error },
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
     #[error("plot {path}: {message}")]
-    Plot { path: std::path::PathBuf, message: String },
+    Plot {
+        path: std::path::PathBuf,
+        message: String,
+    },
 }

@@ -33,10 +33,16 @@ pub fn loglog_png(
     REGISTER.call_once(|| {
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     });
-    let err = |e: &dyn std::fmt::Display| ReportError::Plot { path: path.to_owned(), message: e.to_string() };
+    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
     let (w, h) = (900u32, 600u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
-    let pts = series.iter().flat_map(|s| s.points.iter()).filter(|p| p.0 > 0.0 && p.1 > 0.0);
+    let pts = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for &(x, y) in pts {
         x0 = x0.min(x);
@@ -55,7 +61,10 @@ pub fn loglog_png(
             .margin(15)
             .x_label_area_size(45)
             .y_label_area_size(70)
-            .build_cartesian_2d((x0 / 1.5..x1 * 1.5).log_scale(), (y0 / 2.0..y1 * 2.0).log_scale())
+            .build_cartesian_2d(
+                (x0 / 1.5..x1 * 1.5).log_scale(),
+                (y0 / 2.0..y1 * 2.0).log_scale(),
+            )
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
@@ -66,22 +75,37 @@ pub fn loglog_png(
             .map_err(|e| err(&e))?;
         for (k, s) in series.iter().enumerate() {
             let color = Palette99::pick(k).to_rgba();
-            let points: Vec<(f64, f64)> = s.points.iter().copied().filter(|p| p.0 > 0.0 && p.1 > 0.0).collect();
+            let points: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+                .collect();
             chart
                 .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
                 .map_err(|e| err(&e))?
                 .label(s.name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
             chart
                 .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(|e| err(&e))?;
         }
         for (x, y, label) in marked {
             chart
-                .draw_series(std::iter::once(Circle::new((*x, *y), 9, BLACK.stroke_width(2))))
+                .draw_series(std::iter::once(Circle::new(
+                    (*x, *y),
+                    9,
+                    BLACK.stroke_width(2),
+                )))
                 .map_err(|e| err(&e))?;
             chart
-                .draw_series(std::iter::once(Text::new(label.clone(), (*x, *y), ("sans-serif", 15))))
+                .draw_series(std::iter::once(Text::new(
+                    label.clone(),
+                    (*x, *y),
+                    ("sans-serif", 15),
+                )))
                 .map_err(|e| err(&e))?;
         }
         chart
@@ -97,6 +121,8 @@ pub fn loglog_png(
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| err(&e))?;
-    write_atomically(path, |out| out.write_all(&png))
-        .map_err(|source| ReportError::Write { path: path.to_owned(), source })
+    write_atomically(path, |out| out.write_all(&png)).map_err(|source| ReportError::Write {
+        path: path.to_owned(),
+        source,
+    })
 }

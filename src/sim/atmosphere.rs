@@ -167,8 +167,8 @@ impl Atmosphere {
             prev_inv_tv = Some(1.0 / virtual_temperature(&s));
             rows.push(s);
         }
-        let inversion =
-            (p.inversion_strength_k > 0.0 && p.inversion_base_m < top).then_some(p.inversion_base_m);
+        let inversion = (p.inversion_strength_k > 0.0 && p.inversion_base_m < top)
+            .then_some(p.inversion_base_m);
         Self::finish(rows, inversion)
     }
 

@@ -36,22 +36,35 @@ pub struct Lcl {
 pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
     let Some(td0) = dewpoint(qv, p_pa) else {
         // Dry air never condenses: report the top of the atmosphere.
-        return Lcl { pressure_pa: 0.0, temperature_k: 0.0 };
+        return Lcl {
+            pressure_pa: 0.0,
+            temperature_k: 0.0,
+        };
     };
     if td0 >= t_k {
-        return Lcl { pressure_pa: p_pa, temperature_k: t_k };
+        return Lcl {
+            pressure_pa: p_pa,
+            temperature_k: t_k,
+        };
     }
     let gap = |p: f64| t_k * (p / p_pa).powf(KAPPA) - dewpoint(qv, p).unwrap_or(0.0);
     let (mut lo, mut hi) = (1.0_f64, p_pa);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        if gap(mid) > 0.0 { hi = mid } else { lo = mid }
+        if gap(mid) > 0.0 {
+            hi = mid
+        } else {
+            lo = mid
+        }
         if hi - lo < 1e-6 {
             break;
         }
     }
     let p = 0.5 * (lo + hi);
-    Lcl { pressure_pa: p, temperature_k: t_k * (p / p_pa).powf(KAPPA) }
+    Lcl {
+        pressure_pa: p,
+        temperature_k: t_k * (p / p_pa).powf(KAPPA),
+    }
 }
 
 /// Pseudo-adiabatic lapse `dT/dp`, K/Pa (the form MetPy's `moist_lapse`
@@ -108,12 +121,18 @@ pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
     let (t0, q0, p0) = (lv[0].temperature_k, lv[0].mixing_ratio, p_of(0));
     let q0v = q0.min(saturation_mixing_ratio(t0, p0));
     let lcl = lcl(t0, q0v, p0);
-    let lcl_height_m = (1..lv.len()).find(|&i| p_of(i) <= lcl.pressure_pa).map(|i| {
-        let (pa, pb) = (p_of(i - 1), p_of(i));
-        let f = ((lcl.pressure_pa.ln() - pa.ln()) / (pb.ln() - pa.ln())).clamp(0.0, 1.0);
-        lv[i - 1].height_m + f * (lv[i].height_m - lv[i - 1].height_m)
-    });
-    let lcl_height_m = if lcl.pressure_pa >= p0 { Some(lv[0].height_m) } else { lcl_height_m };
+    let lcl_height_m = (1..lv.len())
+        .find(|&i| p_of(i) <= lcl.pressure_pa)
+        .map(|i| {
+            let (pa, pb) = (p_of(i - 1), p_of(i));
+            let f = ((lcl.pressure_pa.ln() - pa.ln()) / (pb.ln() - pa.ln())).clamp(0.0, 1.0);
+            lv[i - 1].height_m + f * (lv[i].height_m - lv[i - 1].height_m)
+        });
+    let lcl_height_m = if lcl.pressure_pa >= p0 {
+        Some(lv[0].height_m)
+    } else {
+        lcl_height_m
+    };
     let theta_l = t0 / exner(p0) - L_V * (q0 - q0v) / (C_P * exner(p0));
     let rows = lv
         .iter()
@@ -150,7 +169,11 @@ pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
             }
         })
         .collect();
-    Profile { lcl, lcl_height_m, rows }
+    Profile {
+        lcl,
+        lcl_height_m,
+        rows,
+    }
 }
 
 /// LCL height (m) of the air at the bottom of a tabulated atmosphere, if it
@@ -177,7 +200,11 @@ mod tests {
         assert!((l.temperature_k - td).abs() < 1e-4);
         // Bolton (1980) Eq. 15 estimate of T_LCL agrees within 0.1 K.
         let bolton = 1.0 / (1.0 / (290.0 - 56.0) + (300.0_f64 / 290.0).ln() / 800.0) + 56.0;
-        assert!((l.temperature_k - bolton).abs() < 0.1, "{} vs {bolton}", l.temperature_k);
+        assert!(
+            (l.temperature_k - bolton).abs() < 0.1,
+            "{} vs {bolton}",
+            l.temperature_k
+        );
     }
 
     #[test]

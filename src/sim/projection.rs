@@ -71,10 +71,16 @@ impl ProjectedField {
 
     /// Re-projects `parcels` (positions in a periodic square of side
     /// `domain_m`) into the field.
-    pub fn project(&mut self, parcels: &Parcels, domain_m: f64, band: Band, fill_full_condensed_fraction: f64) {
+    pub fn project(
+        &mut self,
+        parcels: &Parcels,
+        domain_m: f64,
+        band: Band,
+        fill_full_condensed_fraction: f64,
+    ) {
         self.texels.fill([0.0; 3]);
         self.weight.fill(0.0);
-        if self.texels.is_empty() || !(domain_m > 0.0) {
+        if self.texels.is_empty() || domain_m.is_nan() || domain_m <= 0.0 {
             return;
         }
         let (w, h) = (self.width as i64, self.height as i64);
@@ -84,13 +90,17 @@ impl ProjectedField {
         let full = fill_full_condensed_fraction.max(1e-12);
         for i in 0..parcels.len() {
             let d = &parcels.diag[i];
-            if !(d.qc > 0.0) || !parcels.life[i].released() {
+            if d.qc.is_nan() || d.qc <= 0.0 || !parcels.life[i].released() {
                 continue;
             }
             let p = parcels.pos[i];
             let zn = ((p.z - band.bottom_m) / span).clamp(0.0, 1.0) as f32;
             let qt = parcels.qt[i];
-            let fill = if qt > 0.0 { (d.qc / qt / full).clamp(0.0, 1.0) } else { 0.0 } as f32;
+            let fill = if qt > 0.0 {
+                (d.qc / qt / full).clamp(0.0, 1.0)
+            } else {
+                0.0
+            } as f32;
             // Texel centres at (k + 0.5) / scale.
             let (cx, cy) = (p.x * sx - 0.5, p.y * sy - 0.5);
             let (rx, ry) = (parcels.life[i].radius_m * sx, parcels.life[i].radius_m * sy);
@@ -145,18 +155,32 @@ mod tests {
             p.vel.push(DVec3::ZERO);
             p.theta_l.push(300.0);
             p.qt.push(0.016);
-            p.diag.push(Diag { qc, ..Diag::default() });
-            p.life.push(Life { radius_m: r, ..Life::default() });
+            p.diag.push(Diag {
+                qc,
+                ..Diag::default()
+            });
+            p.life.push(Life {
+                radius_m: r,
+                ..Life::default()
+            });
         }
         p
     }
 
-    const BAND: Band = Band { bottom_m: 500.0, top_m: 1500.0 };
+    const BAND: Band = Band {
+        bottom_m: 500.0,
+        top_m: 1500.0,
+    };
 
     #[test]
     fn disc_area_matches_parcel_footprint() {
         let mut f = ProjectedField::new(200, 200);
-        f.project(&parcels(&[(500.0, 500.0, 1000.0, 200.0, 0.001)]), 1000.0, BAND, 0.08);
+        f.project(
+            &parcels(&[(500.0, 500.0, 1000.0, 200.0, 0.001)]),
+            1000.0,
+            BAND,
+            0.08,
+        );
         let area: f64 = f.texels().iter().map(|t| t[0] as f64).sum::<f64>() * 25.0; // 5 m texels
         let want = std::f64::consts::PI * 200.0 * 200.0;
         // The soft edge integrates to the disc area to within a texel ring.
@@ -171,7 +195,10 @@ mod tests {
     fn overlaps_are_averaged() {
         let mut f = ProjectedField::new(100, 100);
         f.project(
-            &parcels(&[(500.0, 500.0, 500.0, 300.0, 0.001), (520.0, 500.0, 1500.0, 300.0, 0.001)]),
+            &parcels(&[
+                (500.0, 500.0, 500.0, 300.0, 0.001),
+                (520.0, 500.0, 1500.0, 300.0, 0.001),
+            ]),
             1000.0,
             BAND,
             0.08,
@@ -182,9 +209,19 @@ mod tests {
     #[test]
     fn uncondensed_parcels_project_nothing_and_edges_wrap() {
         let mut f = ProjectedField::new(64, 64);
-        f.project(&parcels(&[(500.0, 500.0, 900.0, 200.0, 0.0)]), 1000.0, BAND, 0.08);
+        f.project(
+            &parcels(&[(500.0, 500.0, 900.0, 200.0, 0.0)]),
+            1000.0,
+            BAND,
+            0.08,
+        );
         assert_eq!(f.covered_fraction(), 0.0);
-        f.project(&parcels(&[(0.0, 0.0, 900.0, 100.0, 0.001)]), 1000.0, BAND, 0.08);
+        f.project(
+            &parcels(&[(0.0, 0.0, 900.0, 100.0, 0.001)]),
+            1000.0,
+            BAND,
+            0.08,
+        );
         assert_eq!(f.at(0, 0)[0], 1.0);
         assert_eq!(f.at(63, 63)[0], 1.0);
         assert_eq!(f.at(32, 32)[0], 0.0);

@@ -79,6 +79,15 @@ pub struct Simulation {
     active: Vec<u32>,
 }
 
+/// One parcel's state as the zipped iterators hand it out.
+type ParcelRefs<'a> = (
+    (
+        (((&'a mut DVec3, &'a mut DVec3), &'a mut f64), &'a mut f64),
+        &'a mut Diag,
+    ),
+    &'a mut Life,
+);
+
 /// Per-frame constants of the per-parcel update.
 #[derive(Clone, Copy)]
 struct Ctx<'a> {
@@ -133,7 +142,12 @@ impl Simulation {
         cfg.release_stagger_s = 0.0;
         let mut sim = Self::new(cfg, atm);
         for (i, &p) in positions.iter().enumerate() {
-            sim.set_parcel(i, p, sim.cfg.initial_excess_k, sim.cfg.initial_excess_qt_gkg * 1e-3);
+            sim.set_parcel(
+                i,
+                p,
+                sim.cfg.initial_excess_k,
+                sim.cfg.initial_excess_qt_gkg * 1e-3,
+            );
         }
         // The placed parcels are the start: open fresh books.
         sim.initial_water_kg = sim.parcels.water_kg();
@@ -149,7 +163,11 @@ impl Simulation {
         let old = self.parcels.qt[i] * self.parcels.life[i].mass_kg;
         let env = self.atm.at(pos.z);
         let p = &mut self.parcels;
-        p.pos[i] = DVec3::new(pos.x.rem_euclid(self.cfg.domain_size_m), pos.y.rem_euclid(self.cfg.domain_size_m), pos.z.max(0.0));
+        p.pos[i] = DVec3::new(
+            pos.x.rem_euclid(self.cfg.domain_size_m),
+            pos.y.rem_euclid(self.cfg.domain_size_m),
+            pos.z.max(0.0),
+        );
         p.theta_l[i] = env.theta_l + excess_k;
         p.qt[i] = (env.qt + excess_qt).max(0.0);
         let w = wind_at(&self.cfg, pos.z);
@@ -219,8 +237,11 @@ impl Simulation {
             min_substep_s: f64::INFINITY,
             ..StepStats::default()
         };
-        if !(dt_s > 0.0) || !dt_s.is_finite() {
-            return StepStats { min_substep_s: 0.0, ..stats };
+        if !dt_s.is_finite() || dt_s <= 0.0 {
+            return StepStats {
+                min_substep_s: 0.0,
+                ..stats
+            };
         }
         let cap = self.cfg.substeps.max_per_frame.max(1);
         let mut left = dt_s;
@@ -276,7 +297,11 @@ impl Simulation {
                 bound = bound.min(0.125 * h * h / self.cfg.sph.viscosity_m2ps);
             }
         }
-        if bound.is_finite() && bound > 0.0 { bound } else { f64::INFINITY }
+        if bound.is_finite() && bound > 0.0 {
+            bound
+        } else {
+            f64::INFINITY
+        }
     }
 
     fn smoothing_m(&self) -> f64 {
@@ -288,14 +313,22 @@ impl Simulation {
         let sph_on = self.cfg.sph.enabled && n > 1;
         if sph_on {
             self.active.clear();
-            self.active.extend((0..n as u32).filter(|&i| self.parcels.life[i as usize].released()));
+            self.active
+                .extend((0..n as u32).filter(|&i| self.parcels.life[i as usize].released()));
             let params = SphParams {
                 h: self.smoothing_m(),
                 domain_m: self.cfg.domain_size_m,
                 sound_speed: self.cfg.sph.sound_speed_mps,
                 viscosity: self.cfg.sph.viscosity_m2ps,
             };
-            sph::accelerations(&mut self.grid, &self.parcels.pos, &self.parcels.vel, &self.active, &params, &mut self.sph_acc);
+            sph::accelerations(
+                &mut self.grid,
+                &self.parcels.pos,
+                &self.parcels.vel,
+                &self.active,
+                &params,
+                &mut self.sph_acc,
+            );
         }
         let a = self.cfg.wind.direction_deg.to_radians();
         let ctx = Ctx {
@@ -307,7 +340,7 @@ impl Simulation {
         let zero = [DVec3::ZERO];
         let acc: &[DVec3] = if sph_on { &self.sph_acc } else { &zero };
         let p = &mut self.parcels;
-        let update = |(i, (((((pos, vel), th), qt), diag), life)): (usize, (((((&mut DVec3, &mut DVec3), &mut f64), &mut f64), &mut Diag), &mut Life))| {
+        let update = |(i, (((((pos, vel), th), qt), diag), life)): (usize, ParcelRefs)| {
             let a = if sph_on { acc[i] } else { DVec3::ZERO };
             advance_parcel(&ctx, a, pos, vel, th, qt, diag, life);
         };
@@ -347,8 +380,15 @@ impl Simulation {
                 // Hand back the parcel's water, retire its books, re-birth.
                 self.retired_detrained.merge(&life.detrained_kg);
                 self.retired_entrained.merge(&life.entrained_kg);
-                self.retired_detrained.add(self.parcels.qt[i] * life.mass_kg);
-                spawn(&self.cfg, &self.atm, &mut self.parcels, i, life.generation + 1);
+                self.retired_detrained
+                    .add(self.parcels.qt[i] * life.mass_kg);
+                spawn(
+                    &self.cfg,
+                    &self.atm,
+                    &mut self.parcels,
+                    i,
+                    life.generation + 1,
+                );
                 let l = &self.parcels.life[i];
                 self.retired_entrained.add(self.parcels.qt[i] * l.mass_kg);
                 count += 1;
@@ -457,7 +497,11 @@ fn advance_parcel(
         return;
     }
     let r = life.radius_m;
-    let eps = if cfg.entrainment.enabled { cfg.entrainment.coefficient / r } else { 0.0 };
+    let eps = if cfg.entrainment.enabled {
+        cfg.entrainment.coefficient / r
+    } else {
+        0.0
+    };
     let drag = 0.375 * cfg.drag_coefficient / r;
     let k = eps + drag;
     let inv_vm = 1.0 / (1.0 + cfg.virtual_mass);
@@ -519,7 +563,12 @@ fn advance_parcel(
     // 5. Detrainment of cloud water, faster when negatively buoyant.
     if cfg.detrainment.enabled && d.qc > 0.0 {
         let det = &cfg.detrainment;
-        let rate = det.rate_per_s * if d.buoyancy < 0.0 { 1.0 + det.sorting_factor } else { 1.0 };
+        let rate = det.rate_per_s
+            * if d.buoyancy < 0.0 {
+                1.0 + det.sorting_factor
+            } else {
+                1.0
+            };
         let shed = d.qc * -(-rate * dt).exp_m1();
         *qt -= shed;
         // Liquid leaves at the parcel's temperature: θ is unchanged, θ_l rises.
@@ -544,7 +593,11 @@ mod tests {
 
     #[test]
     fn implicit_drag_kick_solves_its_equation() {
-        for (w, a, k, dt) in [(3.0, 0.1, 0.01, 5.0), (-2.0, 0.0, 1.0, 100.0), (0.0, -0.5, 0.002, 600.0)] {
+        for (w, a, k, dt) in [
+            (3.0, 0.1, 0.01, 5.0),
+            (-2.0, 0.0, 1.0, 100.0),
+            (0.0, -0.5, 0.002, 600.0),
+        ] {
             let w1 = implicit_drag_kick(w, a, k, dt);
             let lhs = w1 + k * dt * w1 * w1.abs();
             assert!((lhs - (w + a * dt)).abs() < 1e-12, "{w} {a} {k} {dt}: {w1}");

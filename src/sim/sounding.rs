@@ -125,7 +125,10 @@ impl Sounding {
                     .parse()
                     .map_err(|_| err(line, format!("`{name}` is `{s}`, expected a number")))?;
                 if !v.is_finite() {
-                    return Err(err(line, format!("`{name}` is `{s}`, expected a finite number")));
+                    return Err(err(
+                        line,
+                        format!("`{name}` is `{s}`, expected a finite number"),
+                    ));
                 }
                 Ok(Some(v))
             };
@@ -143,15 +146,24 @@ impl Sounding {
                 },
             )?;
             if h < 0.0 {
-                return Err(err(line, format!("`height_m` is {h}, expected >= 0 (height above ground)")));
+                return Err(err(
+                    line,
+                    format!("`height_m` is {h}, expected >= 0 (height above ground)"),
+                ));
             }
             if let Some(p) = p {
                 if !(1.0..=1200.0).contains(&p) {
-                    return Err(err(line, format!("`pressure_hPa` is {p}, expected 1..=1200")));
+                    return Err(err(
+                        line,
+                        format!("`pressure_hPa` is {p}, expected 1..=1200"),
+                    ));
                 }
             }
             if !(-120.0..=70.0).contains(&t) {
-                return Err(err(line, format!("`temperature_C` is {t}, expected -120..=70")));
+                return Err(err(
+                    line,
+                    format!("`temperature_C` is {t}, expected -120..=70"),
+                ));
             }
             match humidity {
                 Humidity::DewpointC if hum > t + 10.0 || hum < -150.0 => {
@@ -161,7 +173,10 @@ impl Sounding {
                     ));
                 }
                 Humidity::RelativeHumidityPct if !(0.0..=150.0).contains(&hum) => {
-                    return Err(err(line, format!("`relative_humidity_pct` is {hum}, expected 0..=150")));
+                    return Err(err(
+                        line,
+                        format!("`relative_humidity_pct` is {hum}, expected 0..=150"),
+                    ));
                 }
                 _ => {}
             }
@@ -177,7 +192,12 @@ impl Sounding {
                 }
                 if let (Some(p), Some(pp)) = (p, prev.p) {
                     if p >= pp {
-                        return Err(err(line, format!("`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height")));
+                        return Err(err(
+                            line,
+                            format!(
+                                "`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height"
+                            ),
+                        ));
                     }
                 }
             }
@@ -271,7 +291,11 @@ impl Sounding {
     pub fn inversion_base_m(&self) -> Option<f64> {
         self.levels
             .windows(2)
-            .find(|w| w[0].height_m >= 200.0 && w[0].height_m < 6000.0 && w[1].temperature_k >= w[0].temperature_k)
+            .find(|w| {
+                w[0].height_m >= 200.0
+                    && w[0].height_m < 6000.0
+                    && w[1].temperature_k >= w[0].temperature_k
+            })
             .map(|w| w[0].height_m)
     }
 }
@@ -308,16 +332,21 @@ mod tests {
 
     #[test]
     fn non_numeric_field_names_column_and_line() {
-        let e = parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,warm,10\n10,999,20,10\n")
-            .expect_err("non-numeric");
+        let e =
+            parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,warm,10\n10,999,20,10\n")
+                .expect_err("non-numeric");
         let msg = e.to_string();
-        assert!(msg.contains("s.csv:2:") && msg.contains("temperature_C"), "{msg}");
+        assert!(
+            msg.contains("s.csv:2:") && msg.contains("temperature_C"),
+            "{msg}"
+        );
     }
 
     #[test]
     fn nan_is_rejected() {
-        let e = parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,NaN,10\n10,999,20,10\n")
-            .expect_err("nan");
+        let e =
+            parse("height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,NaN,10\n10,999,20,10\n")
+                .expect_err("nan");
         assert!(e.to_string().contains("finite"), "{e}");
     }
 

@@ -69,7 +69,10 @@ impl NeighbourGrid {
     /// Sorts the active parcels into cells.
     fn build(&mut self, pos: &[DVec3], active: &[u32], p: &SphParams) {
         self.h = p.h;
-        let z_max = active.iter().map(|&i| pos[i as usize].z).fold(0.0_f64, f64::max);
+        let z_max = active
+            .iter()
+            .map(|&i| pos[i as usize].z)
+            .fold(0.0_f64, f64::max);
         let budget = (CELLS_PER_PARCEL * active.len() + 4096) as f64;
         let mut cell = p.h;
         loop {
@@ -110,7 +113,13 @@ impl NeighbourGrid {
     /// Calls `f(j, x_i - x_j, r)` for every other active parcel `j` with
     /// `r < h` (minimum-image distance in the periodic plane).
     #[inline]
-    fn for_each_neighbour(&self, i: usize, pos: &[DVec3], l: f64, mut f: impl FnMut(usize, DVec3, f64)) {
+    fn for_each_neighbour(
+        &self,
+        i: usize,
+        pos: &[DVec3],
+        l: f64,
+        mut f: impl FnMut(usize, DVec3, f64),
+    ) {
         let pi = pos[i];
         let (cx, cy, cz) = self.cell(pi);
         // Distinct wrapped offsets along each axis (fewer than 3 where the
@@ -207,9 +216,16 @@ pub fn accelerations(
     // Queries in cell order: consecutive queries read the same cells.
     let queries = &grid.order;
     let rho: Vec<(u32, f64)> = if parallel {
-        queries.par_iter().with_min_len(64).map(|&i| (i, density_of(i as usize))).collect()
+        queries
+            .par_iter()
+            .with_min_len(64)
+            .map(|&i| (i, density_of(i as usize)))
+            .collect()
     } else {
-        queries.iter().map(|&i| (i, density_of(i as usize))).collect()
+        queries
+            .iter()
+            .map(|&i| (i, density_of(i as usize)))
+            .collect()
     };
     for (i, r) in rho {
         density[i as usize] = r;
@@ -227,7 +243,11 @@ pub fn accelerations(
         a
     };
     let out: Vec<(u32, DVec3)> = if parallel {
-        queries.par_iter().with_min_len(64).map(|&i| (i, accel_of(i as usize))).collect()
+        queries
+            .par_iter()
+            .with_min_len(64)
+            .map(|&i| (i, accel_of(i as usize)))
+            .collect()
     } else {
         queries.iter().map(|&i| (i, accel_of(i as usize))).collect()
     };
@@ -281,17 +301,31 @@ mod tests {
                 let mut found = Vec::new();
                 grid.for_each_neighbour(i, &pos, domain, |j, _, _| found.push(j));
                 found.sort_unstable();
-                assert_eq!(found, brute_force_neighbours(&pos, i, p.h, domain), "domain {domain}, parcel {i}");
+                assert_eq!(
+                    found,
+                    brute_force_neighbours(&pos, i, p.h, domain),
+                    "domain {domain}, parcel {i}"
+                );
             }
         }
     }
 
     #[test]
     fn overlapping_parcels_repel_and_conserve_momentum() {
-        let pos = vec![DVec3::new(500.0, 500.0, 300.0), DVec3::new(540.0, 500.0, 300.0)];
+        let pos = vec![
+            DVec3::new(500.0, 500.0, 300.0),
+            DVec3::new(540.0, 500.0, 300.0),
+        ];
         let vel = vec![DVec3::ZERO; 2];
         let mut acc = Vec::new();
-        accelerations(&mut NeighbourGrid::default(), &pos, &vel, &[0, 1], &params(2000.0), &mut acc);
+        accelerations(
+            &mut NeighbourGrid::default(),
+            &pos,
+            &vel,
+            &[0, 1],
+            &params(2000.0),
+            &mut acc,
+        );
         assert!(acc[0].x < 0.0 && acc[1].x > 0.0, "{acc:?}");
         assert!((acc[0] + acc[1]).length() < 1e-15 * acc[0].length().max(1.0));
     }
@@ -302,7 +336,14 @@ mod tests {
         let vel = vec![DVec3::ZERO; 50];
         let active: Vec<u32> = (0..50).collect();
         let mut acc = Vec::new();
-        accelerations(&mut NeighbourGrid::default(), &pos, &vel, &active, &params(1000.0), &mut acc);
+        accelerations(
+            &mut NeighbourGrid::default(),
+            &pos,
+            &vel,
+            &active,
+            &params(1000.0),
+            &mut acc,
+        );
         assert!(acc.iter().all(|a| a.is_finite()));
     }
 }

@@ -173,7 +173,12 @@ mod tests {
         let theta_l = t0 / ex;
         let a = saturation_adjust(theta_l, qt, p, ex);
         let qs = saturation_mixing_ratio(a.t_k, p);
-        assert!((a.qv - qs).abs() < 1e-12 * qs.max(1e-3), "qv {} qs {}", a.qv, qs);
+        assert!(
+            (a.qv - qs).abs() < 1e-12 * qs.max(1e-3),
+            "qv {} qs {}",
+            a.qv,
+            qs
+        );
         assert_eq!(a.qv + a.qc, qt);
         let back = liquid_water_potential_temperature(a.t_k / ex, a.qc, ex);
         assert!((back - theta_l).abs() < 1e-9);

@@ -56,8 +56,13 @@ mod tests {
         let x = DVec3::new(3.0, 1.0, -2.0);
         let g = Spiky::grad_w(x, x.length(), h);
         let eps = 1e-6;
-        let fd = (Spiky::w((x + DVec3::X * eps).length(), h) - Spiky::w((x - DVec3::X * eps).length(), h))
+        let fd = (Spiky::w((x + DVec3::X * eps).length(), h)
+            - Spiky::w((x - DVec3::X * eps).length(), h))
             / (2.0 * eps);
-        assert!((g.x - fd).abs() < 1e-9 * fd.abs().max(1e-12) + 1e-12, "{} vs {fd}", g.x);
+        assert!(
+            (g.x - fd).abs() < 1e-9 * fd.abs().max(1e-12) + 1e-12,
+            "{} vs {fd}",
+            g.x
+        );
     }
 }

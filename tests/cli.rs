@@ -1,0 +1,304 @@
+//! The `cumulus` binary from the outside: outputs, and bad input giving a
+//! clear error (file, line, key), a non-zero exit, no panic and no output
+//! file.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn cumulus(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Runs `simulate` on a scene written to a temp dir; asserts failure with a
+/// message containing every `needle`, no panic, no output file.
+fn assert_simulate_fails(scene: &str, sounding: Option<&str>, needles: &[&str]) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene_path = dir.path().join("bad.toml");
+    std::fs::write(&scene_path, scene).expect("write scene");
+    if let Some(s) = sounding {
+        std::fs::write(dir.path().join("snd.csv"), s).expect("write sounding");
+    }
+    let out = dir.path().join("curves.csv");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        scene_path.to_str().unwrap(),
+        "--duration-s",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "should fail: {err}");
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "clean error exit, not a panic (101): {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "stderr lacks `{n}`: {err}");
+    }
+    assert!(!out.exists(), "no output file on error");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(
+        leftovers.len(),
+        1 + usize::from(sounding.is_some()),
+        "no temp files left: {leftovers:?}"
+    );
+}
+
+const GOOD_SOUNDING: &str =
+    "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n1000,,12,8\n3000,,0,-5\n";
+
+#[test]
+fn malformed_toml_names_file_and_line() {
+    assert_simulate_fails(
+        "name = \"x\"\n[physics\nparcels = 3\n",
+        None,
+        &["bad.toml:2:"],
+    );
+}
+
+#[test]
+fn unknown_key_names_file_line_and_key() {
+    assert_simulate_fails(
+        "[physics]\nparcels = 3\nradiuss_m = 5\n",
+        None,
+        &["bad.toml:3:", "radiuss_m"],
+    );
+}
+
+#[test]
+fn negative_radius_names_key() {
+    assert_simulate_fails(
+        "[physics]\nradius_m = -300\n",
+        None,
+        &["bad.toml:2", "physics.radius_m", "-300"],
+    );
+}
+
+#[test]
+fn nan_field_is_rejected() {
+    assert_simulate_fails(
+        "[physics]\ndt_s = nan\n",
+        None,
+        &["bad.toml:2", "physics.dt_s"],
+    );
+}
+
+#[test]
+fn unsorted_sounding_names_line() {
+    let s = "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n900,,12,8\n800,,11,7\n";
+    assert_simulate_fails(
+        "[atmosphere]\nsounding = \"snd.csv\"\n",
+        Some(s),
+        &["snd.csv:4:", "strictly increasing"],
+    );
+}
+
+#[test]
+fn non_numeric_sounding_names_line_and_column() {
+    let s = "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n900,,twelve,8\n";
+    assert_simulate_fails(
+        "[atmosphere]\nsounding = \"snd.csv\"\n",
+        Some(s),
+        &["snd.csv:3:", "temperature_C", "twelve"],
+    );
+}
+
+#[test]
+fn missing_sounding_file_is_named() {
+    assert_simulate_fails(
+        "[atmosphere]\nsounding = \"nowhere.csv\"\n",
+        None,
+        &["nowhere.csv", "cannot read sounding"],
+    );
+}
+
+#[test]
+fn missing_scene_file_is_named() {
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        "/no/such/scene.toml",
+        "--out",
+        "/tmp/never.csv",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("/no/such/scene.toml"), "{}", stderr(&o));
+}
+
+#[test]
+fn bad_flag_value_is_an_error_after_overrides() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.csv");
+    let scene = root().join("scenes/bomex.toml");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--dt-s",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("physics.dt_s"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+#[test]
+fn simulate_writes_the_fig5_columns_for_every_parcel() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("curves.csv");
+    let scene = root().join("scenes/bomex.toml");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--duration-s",
+        "1200",
+        "--every-s",
+        "600",
+        "--parcels",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut r = csv::Reader::from_path(&out).unwrap();
+    let header = r.headers().unwrap().clone();
+    for col in [
+        "t_s",
+        "id",
+        "x_m",
+        "y_m",
+        "z_m",
+        "w_mps",
+        "theta_v_K",
+        "theta_v_env_K",
+        "T_K",
+        "qv_gkg",
+        "qc_gkg",
+        "qt_gkg",
+        "buoyancy_mps2",
+        "condensed_fraction",
+        "fill",
+    ] {
+        assert!(header.iter().any(|h| h == col), "missing column {col}");
+    }
+    let rows: Vec<_> = r.records().map(|x| x.unwrap()).collect();
+    // t = 0, 600, 1200: three output steps of five parcels.
+    assert_eq!(rows.len(), 15);
+    for row in &rows {
+        for f in row.iter() {
+            assert!(
+                f.parse::<f64>().map(f64::is_finite).unwrap_or(false),
+                "non-numeric field {f}"
+            );
+        }
+    }
+}
+
+#[test]
+fn profile_prints_lcl_and_writes_one_row_per_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.csv");
+    let snd = root().join("scenes/bomex_sounding.csv");
+    let o = cumulus(&[
+        "profile",
+        "--sounding",
+        snd.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let z: f64 = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("lcl_height_m="))
+        .expect("lcl_height_m line")
+        .parse()
+        .unwrap();
+    // MetPy: 576.0 m (tests/reference/lcl.csv).
+    assert!((z - 576.0).abs() < 10.0, "{z}");
+    assert!(stdout.contains("lcl_pressure_hPa=") && stdout.contains("lcl_temperature_K="));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with(
+        "height_m,pressure_hPa,env_T_K,parcel_T_K,parcel_qv_gkg,parcel_qc_gkg,buoyancy_mps2\n"
+    ));
+    let levels = std::fs::read_to_string(&snd)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .count()
+        - 1;
+    assert_eq!(text.lines().count() - 1, levels);
+}
+
+#[test]
+fn scene_check_accepts_shipped_scenes_and_rejects_bad_ones() {
+    for s in ["bomex", "fair_weather", "strong_inversion"] {
+        let o = cumulus(&[
+            "scene",
+            "check",
+            root().join(format!("scenes/{s}.toml")).to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{s}: {}", stderr(&o));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("s.toml");
+    std::fs::write(&p, "[physics.sph]\nsound_speed_mps = -1\n").unwrap();
+    let o = cumulus(&["scene", "check", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("s.toml:2: `physics.sph.sound_speed_mps`"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = Path::new("");
+}
+
+#[test]
+fn sounding_flag_replaces_the_scene_atmosphere() {
+    let dir = tempfile::tempdir().unwrap();
+    let snd = dir.path().join("good.csv");
+    std::fs::write(&snd, GOOD_SOUNDING).unwrap();
+    let out = dir.path().join("c.csv");
+    let scene = root().join("scenes/fair_weather.toml");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--sounding",
+        snd.to_str().unwrap(),
+        "--duration-s",
+        "60",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The environment now comes from the 3-level sounding: θ_v,env at the
+    // release height (50 m) is that of 20 °C at ~994 hPa with 15 °C dewpoint.
+    let mut r = csv::Reader::from_path(&out).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = h.iter().position(|c| c == "theta_v_env_K").unwrap();
+    let row = r.records().next().unwrap().unwrap();
+    let thv: f64 = row[col].parse().unwrap();
+    assert!((thv - 295.2).abs() < 1.0, "θ_v,env {thv}");
+}
