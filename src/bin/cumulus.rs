@@ -86,14 +86,23 @@ struct ProfileArgs {
     #[arg(long)]
     sounding: PathBuf,
     /// Moist adiabat above the LCL: pseudo (condensate removed) or reversible.
-    #[arg(long, value_enum, default_value_t = Adiabat::Pseudo)]
-    adiabat: Adiabat,
+    #[arg(long, value_enum, default_value_t = AdiabatArg::Pseudo)]
+    adiabat: AdiabatArg,
     /// Ground pressure in hPa, used when the sounding gives no pressures.
     #[arg(long, default_value_t = 1013.25)]
     surface_pressure_hpa: f64,
     /// Output CSV, one row per sounding level (written atomically).
     #[arg(long)]
     out: Option<PathBuf>,
+}
+
+/// `--adiabat` (kept here so the simulator does not depend on clap).
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum AdiabatArg {
+    /// Condensate removed as it forms (meteorologists' default).
+    Pseudo,
+    /// Condensate carried with the parcel.
+    Reversible,
 }
 
 #[derive(clap::Args)]
@@ -235,7 +244,11 @@ fn profile(a: ProfileArgs) -> Result<()> {
         );
     }
     let s = Sounding::load(&a.sounding, a.surface_pressure_hpa * 100.0)?;
-    let prof = lift_sounding(&s, a.adiabat);
+    let adiabat = match a.adiabat {
+        AdiabatArg::Pseudo => Adiabat::Pseudo,
+        AdiabatArg::Reversible => Adiabat::Reversible,
+    };
+    let prof = lift_sounding(&s, adiabat);
     println!("lcl_pressure_hPa={:.3}", prof.lcl.pressure_pa / 100.0);
     println!("lcl_temperature_K={:.3}", prof.lcl.temperature_k);
     match prof.lcl_height_m {

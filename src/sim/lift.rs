@@ -11,7 +11,7 @@ use super::sounding::Sounding;
 use super::thermo::{dewpoint, exner, saturation_adjust, saturation_mixing_ratio};
 
 /// Which moist adiabat the parcel follows above its LCL.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Adiabat {
     /// Condensate removed as it forms (meteorologists' default).
