@@ -63,9 +63,42 @@ fn physics(c: &mut Criterion) {
     g.finish();
 }
 
+/// The SPH passes sequential and with rayon, to place
+/// `sph::PARALLEL_THRESHOLD`.
+fn sph_crossover(c: &mut Criterion) {
+    use cumulus::sim::sph::{NeighbourGrid, SphParams, accelerations};
+    let mut g = c.benchmark_group("sph_crossover");
+    for n in [128usize, 256, 512, 1024, 4096] {
+        let sim = spun_up(n);
+        let p = sim.parcels();
+        let active: Vec<u32> = (0..n as u32)
+            .filter(|&i| p.life[i as usize].released())
+            .collect();
+        let params = SphParams {
+            h: 600.0,
+            domain_m: sim.config().domain_size_m,
+            sound_speed: 3.0,
+            viscosity: 100.0,
+        };
+        let mut grid = NeighbourGrid::default();
+        let mut acc = Vec::new();
+        for parallel in [false, true] {
+            let id = BenchmarkId::new(if parallel { "rayon" } else { "sequential" }, n);
+            g.bench_function(id, |b| {
+                b.iter(|| {
+                    accelerations(
+                        &mut grid, &p.pos, &p.vel, &active, &params, parallel, &mut acc,
+                    )
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(3)).warm_up_time(std::time::Duration::from_secs(1));
-    targets = physics
+    targets = physics, sph_crossover
 }
 criterion_main!(benches);

@@ -104,10 +104,12 @@ impl ProjectedField {
             // Texel centres at (k + 0.5) / scale.
             let (cx, cy) = (p.x * sx - 0.5, p.y * sy - 0.5);
             let (rx, ry) = (parcels.life[i].radius_m * sx, parcels.life[i].radius_m * sy);
-            let x0 = (cx - rx - 1.0).floor() as i64;
-            let x1 = (cx + rx + 1.0).ceil() as i64;
-            let y0 = (cy - ry - 1.0).floor() as i64;
-            let y1 = (cy + ry + 1.0).ceil() as i64;
+            // Coverage is positive while dist < 1 + 0.5 / min(rx, ry).
+            let reach = 1.0 + 0.5 / rx.min(ry);
+            let x0 = (cx - rx * reach).floor() as i64;
+            let x1 = (cx + rx * reach).ceil() as i64;
+            let y0 = (cy - ry * reach).floor() as i64;
+            let y1 = (cy + ry * reach).ceil() as i64;
             // A footprint wider than the field wraps onto itself: visit each
             // texel once.
             let (x1, y1) = (x1.min(x0 + w - 1), y1.min(y0 + h - 1));

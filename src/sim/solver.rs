@@ -327,6 +327,7 @@ impl Simulation {
                 &self.parcels.vel,
                 &self.active,
                 &params,
+                self.active.len() >= sph::PARALLEL_THRESHOLD,
                 &mut self.sph_acc,
             );
         }

@@ -15,9 +15,10 @@ use rayon::prelude::*;
 
 use super::kernels::{Kernel, Poly6, Spiky, Viscosity};
 
-/// Above this many active parcels the SPH passes run on all cores (rayon);
-/// below it the thread hand-off costs more than it saves (measured with
-/// `cargo bench --bench physics`, see README).
+/// Above this many active parcels the solver runs the SPH passes on all
+/// cores (rayon); below it the thread hand-off costs more than it saves.
+/// The crossover is measured by `cargo bench --bench physics -- sph_crossover`
+/// (README, Speed).
 pub const PARALLEL_THRESHOLD: usize = 512;
 
 /// Parameters of one SPH evaluation.
@@ -181,13 +182,15 @@ impl NeighbourGrid {
 /// `ρ_0` is a lone parcel's own density `W(0, h)`: any overlap pushes apart,
 /// nothing pulls together. The acceleration
 /// `a_i = -Σ (p_i/ρ_i² + p_j/ρ_j²) ∇W_spiky + ν Σ (v_j - v_i)/ρ_j ∇²W_visc`
-/// is antisymmetric in `i, j`, so momentum is conserved.
+/// is antisymmetric in `i, j`, so momentum is conserved. `parallel` runs
+/// the passes with rayon; the result is the same either way.
 pub fn accelerations(
     grid: &mut NeighbourGrid,
     pos: &[DVec3],
     vel: &[DVec3],
     active: &[u32],
     p: &SphParams,
+    parallel: bool,
     acc: &mut Vec<DVec3>,
 ) {
     acc.clear();
@@ -200,7 +203,6 @@ pub fn accelerations(
     let rho0 = Poly6::w(0.0, p.h);
     let c2 = p.sound_speed * p.sound_speed;
     let l = p.domain_m;
-    let parallel = active.len() >= PARALLEL_THRESHOLD;
 
     let mut density = std::mem::take(&mut grid.density);
     let mut pressure = std::mem::take(&mut grid.pressure);
@@ -324,10 +326,46 @@ mod tests {
             &vel,
             &[0, 1],
             &params(2000.0),
+            false,
             &mut acc,
         );
         assert!(acc[0].x < 0.0 && acc[1].x > 0.0, "{acc:?}");
         assert!((acc[0] + acc[1]).length() < 1e-15 * acc[0].length().max(1.0));
+    }
+
+    #[test]
+    fn rayon_and_sequential_passes_agree_exactly() {
+        let pos: Vec<DVec3> = (0..800)
+            .map(|i| {
+                let u = |s| crate::sim::parcels::keyed_uniform(5, i, 0, s);
+                DVec3::new(u(0) * 2000.0, u(1) * 2000.0, u(2) * 300.0)
+            })
+            .collect();
+        let vel: Vec<DVec3> = (0..800)
+            .map(|i| DVec3::new(i as f64 * 1e-3, 0.0, 0.0))
+            .collect();
+        let active: Vec<u32> = (0..800).collect();
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        accelerations(
+            &mut NeighbourGrid::default(),
+            &pos,
+            &vel,
+            &active,
+            &params(2000.0),
+            false,
+            &mut a,
+        );
+        accelerations(
+            &mut NeighbourGrid::default(),
+            &pos,
+            &vel,
+            &active,
+            &params(2000.0),
+            true,
+            &mut b,
+        );
+        assert_eq!(a, b);
+        assert!(a.iter().any(|x| x.length() > 0.0));
     }
 
     #[test]
@@ -342,6 +380,7 @@ mod tests {
             &vel,
             &active,
             &params(1000.0),
+            true,
             &mut acc,
         );
         assert!(acc.iter().all(|a| a.is_finite()));
