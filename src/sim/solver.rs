@@ -467,6 +467,26 @@ fn diagnose(env: &super::atmosphere::EnvSample, theta_l: f64, qt: f64) -> Diag {
     }
 }
 
+/// `x` wrapped into `[0, l)`; one add or subtract in the usual case of a
+/// parcel that moved less than a domain in a sub-step.
+#[inline]
+fn wrap(x: f64, l: f64) -> f64 {
+    let y = if x < 0.0 {
+        x + l
+    } else if x >= l {
+        x - l
+    } else {
+        return x;
+    };
+    let y = if (0.0..l).contains(&y) {
+        y
+    } else {
+        y.rem_euclid(l)
+    };
+    // rem_euclid can round up to l itself.
+    if y >= l { 0.0 } else { y }
+}
+
 /// `w' + k Δt w'|w'| = w + a Δt`, solved exactly for `w'`: an implicit
 /// quadratic drag that cannot overshoot or change sign on its own.
 #[inline]
@@ -528,14 +548,8 @@ fn advance_parcel(
     // 2. Drift.
     *pos += *vel * dt;
     let l = cfg.domain_size_m;
-    pos.x = pos.x.rem_euclid(l);
-    pos.y = pos.y.rem_euclid(l);
-    if pos.x >= l {
-        pos.x = 0.0;
-    }
-    if pos.y >= l {
-        pos.y = 0.0;
-    }
+    pos.x = wrap(pos.x, l);
+    pos.y = wrap(pos.y, l);
     let top = ctx.atm.top_m();
     if pos.z < 0.0 {
         pos.z = 0.0;

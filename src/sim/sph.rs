@@ -56,9 +56,10 @@ impl NeighbourGrid {
     #[inline]
     fn cell(&self, p: DVec3) -> (i64, i64, i64) {
         (
-            ((p.x / self.cell_xy).floor() as i64).clamp(0, self.nx - 1),
-            ((p.y / self.cell_xy).floor() as i64).clamp(0, self.nx - 1),
-            ((p.z / self.cell_z).floor() as i64).clamp(0, self.nz - 1),
+            // Positions are >= 0 here, so truncation is the floor.
+            ((p.x / self.cell_xy) as i64).clamp(0, self.nx - 1),
+            ((p.y / self.cell_xy) as i64).clamp(0, self.nx - 1),
+            ((p.z / self.cell_z) as i64).clamp(0, self.nz - 1),
         )
     }
 
@@ -204,60 +205,100 @@ pub fn accelerations(
     let c2 = p.sound_speed * p.sound_speed;
     let l = p.domain_m;
 
+    // Pass 1, density: each chunk of queries (in cell order, so consecutive
+    // queries read the same cells) walks the grid once and keeps its
+    // neighbour pairs for pass 2.
+    let density_chunk = |queries: &[u32]| {
+        let mut out = ChunkPairs::default();
+        for &i in queries {
+            let mut rho = rho0;
+            grid.for_each_neighbour(i as usize, pos, l, |j, d, r| {
+                rho += Poly6::w(r, p.h);
+                out.pairs.push(Pair { j: j as u32, d, r });
+            });
+            out.ends.push(out.pairs.len() as u32);
+            out.rho.push(rho);
+        }
+        out
+    };
+    let queries = &grid.order;
+    let chunks: Vec<ChunkPairs> = if parallel {
+        queries.par_chunks(QUERY_CHUNK).map(density_chunk).collect()
+    } else {
+        queries.chunks(QUERY_CHUNK).map(density_chunk).collect()
+    };
     let mut density = std::mem::take(&mut grid.density);
     let mut pressure = std::mem::take(&mut grid.pressure);
     density.clear();
     density.resize(n, rho0);
     pressure.clear();
     pressure.resize(n, 0.0);
-    let density_of = |i: usize| {
-        let mut rho = rho0;
-        grid.for_each_neighbour(i, pos, l, |_, _, r| rho += Poly6::w(r, p.h));
-        rho
-    };
-    // Queries in cell order: consecutive queries read the same cells.
-    let queries = &grid.order;
-    let rho: Vec<(u32, f64)> = if parallel {
-        queries
-            .par_iter()
-            .with_min_len(64)
-            .map(|&i| (i, density_of(i as usize)))
-            .collect()
-    } else {
-        queries
-            .iter()
-            .map(|&i| (i, density_of(i as usize)))
-            .collect()
-    };
-    for (i, r) in rho {
-        density[i as usize] = r;
-        pressure[i as usize] = c2 * (r - rho0).max(0.0);
+    for (qs, c) in queries.chunks(QUERY_CHUNK).zip(&chunks) {
+        for (&i, &r) in qs.iter().zip(&c.rho) {
+            density[i as usize] = r;
+            pressure[i as usize] = c2 * (r - rho0).max(0.0);
+        }
     }
 
-    let accel_of = |i: usize| {
-        let (pi_rho2, vi) = (pressure[i] / (density[i] * density[i]), vel[i]);
-        let mut a = DVec3::ZERO;
-        grid.for_each_neighbour(i, pos, l, |j, d, r| {
-            let pj_rho2 = pressure[j] / (density[j] * density[j]);
-            a -= Spiky::grad_w(d, r, p.h) * (pi_rho2 + pj_rho2);
-            a += (vel[j] - vi) * (p.viscosity * Viscosity::laplacian(r, p.h) / density[j]);
-        });
-        a
+    // Pass 2, forces, over the kept pairs.
+    let force_chunk = |(qs, c): (&[u32], &ChunkPairs)| {
+        let mut start = 0usize;
+        qs.iter()
+            .zip(&c.ends)
+            .map(|(&i, &end)| {
+                let i = i as usize;
+                let (pi_rho2, vi) = (pressure[i] / (density[i] * density[i]), vel[i]);
+                let mut a = DVec3::ZERO;
+                for pair in &c.pairs[start..end as usize] {
+                    let j = pair.j as usize;
+                    let pj_rho2 = pressure[j] / (density[j] * density[j]);
+                    a -= Spiky::grad_w(pair.d, pair.r, p.h) * (pi_rho2 + pj_rho2);
+                    a += (vel[j] - vi)
+                        * (p.viscosity * Viscosity::laplacian(pair.r, p.h) / density[j]);
+                }
+                start = end as usize;
+                (i as u32, a)
+            })
+            .collect::<Vec<_>>()
     };
-    let out: Vec<(u32, DVec3)> = if parallel {
+    let out: Vec<Vec<(u32, DVec3)>> = if parallel {
         queries
-            .par_iter()
-            .with_min_len(64)
-            .map(|&i| (i, accel_of(i as usize)))
+            .par_chunks(QUERY_CHUNK)
+            .zip(chunks.par_iter())
+            .map(force_chunk)
             .collect()
     } else {
-        queries.iter().map(|&i| (i, accel_of(i as usize))).collect()
+        queries
+            .chunks(QUERY_CHUNK)
+            .zip(chunks.iter())
+            .map(force_chunk)
+            .collect()
     };
-    for (i, a) in out {
+    for (i, a) in out.into_iter().flatten() {
         acc[i as usize] = a;
     }
     grid.density = density;
     grid.pressure = pressure;
+}
+
+/// Queries per unit of parallel work.
+const QUERY_CHUNK: usize = 128;
+
+/// A neighbour found in pass 1: index, `x_i - x_j`, distance.
+#[derive(Clone, Copy)]
+struct Pair {
+    j: u32,
+    d: DVec3,
+    r: f64,
+}
+
+/// The pairs and densities of one chunk of queries.
+#[derive(Default)]
+struct ChunkPairs {
+    pairs: Vec<Pair>,
+    /// End of each query's pairs in `pairs`.
+    ends: Vec<u32>,
+    rho: Vec<f64>,
 }
 
 #[cfg(test)]
