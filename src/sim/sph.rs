@@ -34,6 +34,14 @@ pub struct SphParams {
     pub viscosity: f64,
 }
 
+/// `floor(v)` without a libm call (the baseline x86-64 target has no
+/// rounding instruction).
+#[inline]
+fn floor_i64(v: f64) -> i64 {
+    let t = v as i64;
+    if (t as f64) > v { t - 1 } else { t }
+}
+
 /// Most cells the grid may have per active parcel (plus a fixed 4096).
 pub const CELLS_PER_PARCEL: usize = 8;
 
@@ -123,24 +131,32 @@ impl NeighbourGrid {
         mut f: impl FnMut(usize, DVec3, f64),
     ) {
         let pi = pos[i];
-        let (cx, cy, cz) = self.cell(pi);
-        // Distinct wrapped offsets along each axis (fewer than 3 where the
-        // domain is narrower than 3 cells or the column ends).
-        let distinct = |c: i64, n: i64, wrap: bool| {
+        // The cells the sphere of radius h around the parcel overlaps, per
+        // axis (at most 3, as cells are at least h wide), wrapped in the
+        // plane and each visited once.
+        let span = |lo_m: f64, hi_m: f64, cell: f64, n: i64, wrap: bool| {
+            let (lo, hi) = (floor_i64(lo_m / cell), floor_i64(hi_m / cell));
             let mut v = [0i64; 3];
             let mut m = 0;
-            for d in -1..=1 {
-                let x = if wrap { (c + d).rem_euclid(n) } else { c + d };
-                if (0..n).contains(&x) && !v[..m].contains(&x) {
+            if wrap && hi - lo + 1 >= n {
+                for x in 0..n {
                     v[m] = x;
                     m += 1;
+                }
+            } else {
+                for x in lo..=hi {
+                    let x = if wrap { x.rem_euclid(n) } else { x };
+                    if (0..n).contains(&x) && m < 3 {
+                        v[m] = x;
+                        m += 1;
+                    }
                 }
             }
             (v, m)
         };
-        let (xs, mx) = distinct(cx, self.nx, true);
-        let (ys, my) = distinct(cy, self.nx, true);
-        let (zs, mz) = distinct(cz, self.nz, false);
+        let (xs, mx) = span(pi.x - self.h, pi.x + self.h, self.cell_xy, self.nx, true);
+        let (ys, my) = span(pi.y - self.h, pi.y + self.h, self.cell_xy, self.nx, true);
+        let (zs, mz) = span(pi.z - self.h, pi.z + self.h, self.cell_z, self.nz, false);
         let h2 = self.h * self.h;
         let half = 0.5 * l;
         for &iz in &zs[..mz] {
