@@ -21,6 +21,7 @@
 //! ```
 
 pub mod io;
+pub mod render;
 pub mod report;
 pub mod scene;
 pub mod sim;

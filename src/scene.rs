@@ -85,6 +85,7 @@ pub struct Scene {
     pub atmosphere: AtmosphereSection,
     pub physics: PhysicsConfig,
     pub projection: ProjectionSection,
+    pub render: crate::render::cpu::renderer::RenderSettings,
     /// Where the scene was read from (not a key).
     #[serde(skip)]
     pub source: Option<PathBuf>,
@@ -317,6 +318,155 @@ impl Scene {
                 self.projection.height as f64,
             ),
         ];
+        let r = &self.render;
+        let f = |v: f32| v as f64;
+        checks.extend([
+            c(
+                "render.width",
+                (1..=8192).contains(&r.width),
+                "1..=8192 pixels",
+                f(r.width as f32),
+            ),
+            c(
+                "render.height",
+                (1..=8192).contains(&r.height),
+                "1..=8192 pixels",
+                f(r.height as f32),
+            ),
+            c(
+                "render.camera_position_m",
+                r.camera_position_m.iter().all(|x| x.is_finite()),
+                "three finite numbers [x, y, z] in m",
+                f(r.camera_position_m[1]),
+            ),
+            c(
+                "render.camera_yaw_deg",
+                r.camera_yaw_deg.is_finite(),
+                "a finite angle",
+                f(r.camera_yaw_deg),
+            ),
+            c(
+                "render.camera_pitch_deg",
+                finite_in(f(r.camera_pitch_deg), -89.0, 89.0),
+                "-89..=89 degrees",
+                f(r.camera_pitch_deg),
+            ),
+            c(
+                "render.fov_deg",
+                finite_in(f(r.fov_deg), 1.0, 170.0),
+                "1..=170 degrees",
+                f(r.fov_deg),
+            ),
+            c(
+                "render.sun_elevation_deg",
+                finite_in(f(r.sun_elevation_deg), -10.0, 90.0),
+                "-10..=90 degrees",
+                f(r.sun_elevation_deg),
+            ),
+            c(
+                "render.sun_azimuth_deg",
+                r.sun_azimuth_deg.is_finite(),
+                "a finite angle",
+                f(r.sun_azimuth_deg),
+            ),
+            c(
+                "render.coverage",
+                finite_in(f(r.coverage), 0.0, 1.0),
+                "0..=1",
+                f(r.coverage),
+            ),
+            c(
+                "render.extinction_per_m",
+                finite_in(f(r.extinction_per_m), 1e-6, 10.0),
+                "> 0 1/m",
+                f(r.extinction_per_m),
+            ),
+            c(
+                "render.steps",
+                (1..=4096).contains(&r.steps),
+                "1..=4096",
+                r.steps as f64,
+            ),
+            c(
+                "render.shadow_steps",
+                r.shadow_steps <= 64,
+                "0..=64",
+                r.shadow_steps as f64,
+            ),
+            c("render.octaves", r.octaves <= 3, "0..=3", r.octaves as f64),
+            c(
+                "render.haze_distance_m",
+                finite_in(f(r.haze_distance_m), 1.0, 1e7),
+                "> 0 m",
+                f(r.haze_distance_m),
+            ),
+            c(
+                "render.max_distance_m",
+                finite_in(f(r.max_distance_m), 1.0, 1e7),
+                "> 0 m",
+                f(r.max_distance_m),
+            ),
+            c(
+                "render.exposure",
+                finite_in(f(r.exposure), 1e-3, 1e3),
+                "> 0",
+                f(r.exposure),
+            ),
+            c(
+                "render.time_s",
+                finite_in(r.time_s, 0.0, 1e7),
+                "0..=1e7 s",
+                r.time_s,
+            ),
+            c(
+                "render.cloud_map.size",
+                (16..=2048).contains(&r.cloud_map.size),
+                "16..=2048 texels",
+                r.cloud_map.size as f64,
+            ),
+            c(
+                "render.cloud_map.cells",
+                finite_in(r.cloud_map.cells, 1.0, 64.0),
+                "1..=64",
+                r.cloud_map.cells,
+            ),
+            c(
+                "render.cloud_map.detail",
+                finite_in(r.cloud_map.detail, 1.0, 256.0),
+                "1..=256",
+                r.cloud_map.detail,
+            ),
+            c(
+                "render.terrain.relief_m",
+                finite_in(f(r.terrain.relief_m), 0.0, 5000.0),
+                "0..=5000 m",
+                f(r.terrain.relief_m),
+            ),
+            c(
+                "render.terrain.extent_m",
+                finite_in(f(r.terrain.extent_m), 1.0, 1e7),
+                "> 0 m",
+                f(r.terrain.extent_m),
+            ),
+            c(
+                "render.terrain.hills",
+                finite_in(r.terrain.hills, 1.0, 64.0),
+                "1..=64",
+                r.terrain.hills,
+            ),
+            c(
+                "render.terrain.size",
+                (16..=2048).contains(&r.terrain.size),
+                "16..=2048 texels",
+                r.terrain.size as f64,
+            ),
+            c(
+                "render.cloud_map.octaves",
+                (1..=8).contains(&r.cloud_map.octaves),
+                "1..=8",
+                r.cloud_map.octaves as f64,
+            ),
+        ]);
         let opt = |key, v: Option<f64>, lo, hi, expected| {
             v.map(|v| c(key, finite_in(v, lo, hi), expected, v))
         };

@@ -35,6 +35,8 @@ enum Command {
     /// Error against run time: run a scene at steps from 0.1 s to 600 s
     /// against a fine reference; write convergence.csv and convergence.png.
     Convergence(ConvergenceArgs),
+    /// Simulate a scene, then render one sky image (PNG) of its clouds.
+    Render(RenderArgs),
     /// Scene files.
     Scene {
         #[command(subcommand)]
@@ -78,6 +80,39 @@ struct SimulateArgs {
     /// Output CSV, one row per parcel per output step (written atomically).
     #[arg(long)]
     out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene TOML file.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Output PNG (written atomically).
+    #[arg(long)]
+    out: PathBuf,
+    /// Image width in pixels (overrides render.width).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (overrides render.height).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Simulated seconds before the picture (overrides render.time_s).
+    #[arg(long)]
+    time_s: Option<f64>,
+    /// Primary ray-march steps (overrides render.steps).
+    #[arg(long)]
+    steps: Option<u32>,
+    /// auto: the GPU when one is usable, else the CPU reference; cpu; gpu.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    backend: Backend,
+}
+
+/// Which renderer draws the image.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Backend {
+    Auto,
+    Cpu,
+    Gpu,
 }
 
 #[derive(clap::Args)]
@@ -130,6 +165,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Simulate(a) => simulate(a),
         Command::Profile(a) => profile(a),
         Command::Convergence(a) => convergence_cmd(a),
+        Command::Render(a) => render_cmd(a),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => {
@@ -334,6 +370,105 @@ fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
     }
     println!(
         "wrote {0}/convergence.csv and {0}/convergence.png",
+        a.out.display()
+    );
+    Ok(())
+}
+
+fn render_cmd(a: RenderArgs) -> Result<()> {
+    use cumulus::render::cloud_map::CloudMap;
+    use cumulus::render::cpu::density::{DensityParams, Fields};
+    use cumulus::render::cpu::renderer::{Frame, render_linear, to_srgb8};
+    use cumulus::sim::ProjectedField;
+
+    let mut scene = load_scene(&a.scene)?;
+    if let Some(w) = a.width {
+        scene.render.width = w;
+    }
+    if let Some(h) = a.height {
+        scene.render.height = h;
+    }
+    if let Some(t) = a.time_s {
+        scene.render.time_s = t;
+    }
+    if let Some(s) = a.steps {
+        scene.render.steps = s;
+    }
+    scene
+        .validate()
+        .context("after applying --width/--height/--time-s/--steps")?;
+    if a.backend == Backend::Gpu {
+        bail!("--backend gpu: the wgpu renderer is not built yet; use --backend cpu (or auto)");
+    }
+    eprintln!("backend: cpu (the CPU reference renderer; no GPU backend is built yet)");
+    let atm = scene.atmosphere(None)?;
+    let band = scene.band(&atm);
+    let r = &scene.render;
+    let cloud_map = CloudMap::generate(&r.cloud_map);
+    let terrain = r
+        .terrain
+        .enabled
+        .then(|| cumulus::render::terrain::Heightfield::generate(&r.terrain));
+    let l = scene.physics.domain_size_m;
+    let sites = cloud_map
+        .cell_centres(64)
+        .into_iter()
+        .map(|(u, v)| glam::DVec2::new(u as f64 * l, v as f64 * l))
+        .collect();
+    let mut sim = Simulation::new(scene.physics.clone(), atm);
+    sim.set_spawn_sites(sites);
+    let frames = (r.time_s / scene.physics.dt_s).round() as u64;
+    let bar = progress_bar(frames, "simulating");
+    for _ in 0..frames {
+        sim.step();
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
+    field.project(
+        sim.parcels(),
+        l,
+        band,
+        scene.physics.fill_full_condensed_fraction,
+    );
+    let frame = Frame {
+        camera: r.camera(),
+        sun_elevation_deg: r.sun_elevation_deg,
+        sun_azimuth_deg: r.sun_azimuth_deg,
+        fields: Fields {
+            p: &field,
+            cloud_map: &cloud_map,
+        },
+        density: DensityParams {
+            band_bottom_m: band.bottom_m as f32,
+            band_top_m: band.top_m as f32,
+            coverage: r.coverage,
+            extinction_per_m: r.extinction_per_m,
+            map_extent_m: l as f32,
+        },
+        quality: r.quality(),
+        terrain: terrain.as_ref(),
+    };
+    let start = std::time::Instant::now();
+    let linear = render_linear(r.width, r.height, &frame);
+    let elapsed = start.elapsed();
+    let bytes = to_srgb8(&linear, r.exposure);
+    let img = image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    write_atomically(&a.out, |w| w.write_all(&png))
+        .with_context(|| format!("{}: cannot write image", a.out.display()))?;
+    eprintln!(
+        "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        r.width,
+        r.height,
+        elapsed.as_secs_f64(),
+        r.steps,
+        r.shadow_steps,
+        r.octaves,
+        100.0 * field.covered_fraction(),
+        band.bottom_m,
+        band.top_m,
         a.out.display()
     );
     Ok(())

@@ -61,6 +61,46 @@ impl ProjectedField {
         self.texels[y * self.width + x]
     }
 
+    /// Bilinear, periodic sample at field coordinate `(u, v)` (1 = the whole
+    /// field; `u` along the width, `v` along the height).
+    pub fn sample(&self, u: f32, v: f32) -> [f32; 3] {
+        let (w, h) = (self.width as i64, self.height as i64);
+        if w == 0 || h == 0 {
+            return [0.0; 3];
+        }
+        let (x, y) = (u * w as f32 - 0.5, v * h as f32 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (xa, xb) = (
+            (x0 as i64).rem_euclid(w) as usize,
+            (x0 as i64 + 1).rem_euclid(w) as usize,
+        );
+        let (ya, yb) = (
+            (y0 as i64).rem_euclid(h) as usize,
+            (y0 as i64 + 1).rem_euclid(h) as usize,
+        );
+        let t = |xx: usize, yy: usize| self.texels[yy * self.width + xx];
+        let lerp = |a: [f32; 3], b: [f32; 3], f: f32| {
+            [
+                a[0] + (b[0] - a[0]) * f,
+                a[1] + (b[1] - a[1]) * f,
+                a[2] + (b[2] - a[2]) * f,
+            ]
+        };
+        lerp(
+            lerp(t(xa, ya), t(xb, ya), fx),
+            lerp(t(xa, yb), t(xb, yb), fx),
+            fy,
+        )
+    }
+
+    /// A field filled with one texel value (for tests and tools).
+    pub fn uniform(width: usize, height: usize, texel: [f32; 3]) -> Self {
+        let mut f = Self::new(width, height);
+        f.texels.fill(texel);
+        f
+    }
+
     /// Fraction of texels with any coverage.
     pub fn covered_fraction(&self) -> f64 {
         if self.texels.is_empty() {

@@ -77,6 +77,8 @@ pub struct Simulation {
     grid: NeighbourGrid,
     sph_acc: Vec<DVec3>,
     active: Vec<u32>,
+    /// Where parcels are born (m, in the domain); empty: anywhere.
+    sites: Vec<DVec2>,
 }
 
 /// One parcel's state as the zipped iterators hand it out.
@@ -113,7 +115,7 @@ impl Simulation {
             life: vec![Life::default(); n],
         };
         for i in 0..n {
-            spawn(&cfg, &atm, &mut parcels, i, 0);
+            spawn(&cfg, &atm, &[], &mut parcels, i, 0);
             let wait = cfg.release_stagger_s * keyed_uniform(cfg.seed, i as u64, 0, 4);
             parcels.life[i].age_s = -wait;
         }
@@ -130,6 +132,34 @@ impl Simulation {
             grid: NeighbourGrid::default(),
             sph_acc: Vec::new(),
             active: Vec::new(),
+            sites: Vec::new(),
+        }
+    }
+
+    /// Births (and re-births) happen at these horizontal sites, m (e.g. the
+    /// cloud map's cell centres, so footprints land on cloud cells: the
+    /// paper's Alg. 1, line 2), each within a parcel radius of its site.
+    /// Parcels not yet released move to their new sites now.
+    pub fn set_spawn_sites(&mut self, sites: Vec<DVec2>) {
+        self.sites = sites;
+        for i in 0..self.parcels.len() {
+            if !self.parcels.life[i].released() {
+                let age = self.parcels.life[i].age_s;
+                let generation = self.parcels.life[i].generation;
+                let before = self.parcels.qt[i] * self.parcels.life[i].mass_kg;
+                spawn(
+                    &self.cfg,
+                    &self.atm,
+                    &self.sites,
+                    &mut self.parcels,
+                    i,
+                    generation,
+                );
+                self.parcels.life[i].age_s = age;
+                let after = self.parcels.qt[i] * self.parcels.life[i].mass_kg;
+                self.retired_detrained.add(before);
+                self.retired_entrained.add(after);
+            }
         }
     }
 
@@ -386,6 +416,7 @@ impl Simulation {
                 spawn(
                     &self.cfg,
                     &self.atm,
+                    &self.sites,
                     &mut self.parcels,
                     i,
                     life.generation + 1,
@@ -426,13 +457,27 @@ fn air_mass(env: &super::atmosphere::EnvSample, radius_m: f64) -> f64 {
 
 /// Places parcel `i` for its `generation`-th life: seeded position and
 /// radius, environment air at the release height plus the excess.
-fn spawn(cfg: &PhysicsConfig, atm: &Atmosphere, p: &mut Parcels, i: usize, generation: u32) {
+fn spawn(
+    cfg: &PhysicsConfig,
+    atm: &Atmosphere,
+    sites: &[DVec2],
+    p: &mut Parcels,
+    i: usize,
+    generation: u32,
+) {
     let u = |s| keyed_uniform(cfg.seed, i as u64, generation, s);
     let l = cfg.domain_size_m;
     let z = cfg.release_height_m;
     let env = atm.at(z);
     let radius = cfg.radius_m * (1.0 + cfg.radius_jitter * (2.0 * u(2) - 1.0));
-    p.pos[i] = DVec3::new(u(0) * l, u(1) * l, z);
+    let xy = if sites.is_empty() {
+        DVec2::new(u(0) * l, u(1) * l)
+    } else {
+        let site = sites[((u(5) * sites.len() as f64) as usize).min(sites.len() - 1)];
+        let (a, r) = (u(0) * std::f64::consts::TAU, cfg.radius_m * u(1).sqrt());
+        site + DVec2::new(a.cos(), a.sin()) * r
+    };
+    p.pos[i] = DVec3::new(xy.x.rem_euclid(l), xy.y.rem_euclid(l), z);
     let w = wind_at(cfg, z);
     p.vel[i] = DVec3::new(w.x, w.y, 0.0);
     p.theta_l[i] = env.theta_l + cfg.initial_excess_k;

@@ -1,0 +1,13 @@
+//! The CPU reference renderer. Each function here has (or will have) a
+//! WGSL twin of the same name in `shaders/clouds.wgsl`: pure functions on
+//! plain `f32` data and glam vectors.
+//!
+//! World frame: `x` east, `y` up, `z` north, metres. The physics domain's
+//! `(x, y)` maps to the world's `(x, z)`; P and the cloud map both span
+//! `map_extent_m` and repeat to the horizon.
+
+pub mod camera;
+pub mod density;
+pub mod lighting;
+pub mod renderer;
+pub mod sky;

@@ -1,0 +1,6 @@
+//! Rendering: the cloud map, and the CPU reference renderer (the oracle
+//! and fallback that the wgpu renderer will be tested against).
+
+pub mod cloud_map;
+pub mod cpu;
+pub mod terrain;

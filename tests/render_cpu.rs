@@ -1,0 +1,293 @@
+//! The CPU reference renderer: density, lighting and image properties.
+
+use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
+use cumulus::render::cpu::camera::Camera;
+use cumulus::render::cpu::density::{
+    BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
+};
+use cumulus::render::cpu::lighting::sun_transmittance;
+use cumulus::render::cpu::renderer::{Frame, Quality, march_ray, render_linear, to_srgb8};
+use cumulus::sim::ProjectedField;
+use glam::Vec3;
+
+const D: DensityParams = DensityParams {
+    band_bottom_m: 600.0,
+    band_top_m: 1600.0,
+    coverage: 0.75,
+    extinction_per_m: 0.04,
+    map_extent_m: 10_000.0,
+};
+
+fn cloud_map() -> CloudMap {
+    CloudMap::generate(&CloudMapConfig {
+        size: 128,
+        ..CloudMapConfig::default()
+    })
+}
+
+#[test]
+fn density_is_zero_outside_the_band_and_where_coverage_is_zero() {
+    let cm = cloud_map();
+    let full = ProjectedField::uniform(32, 32, [1.0, 0.8, 1.0]);
+    let empty = ProjectedField::uniform(32, 32, [0.0, 0.8, 1.0]);
+    let f = Fields {
+        p: &full,
+        cloud_map: &cm,
+    };
+    let e = Fields {
+        p: &empty,
+        cloud_map: &cm,
+    };
+    let mut inside = 0;
+    for i in 0..2000 {
+        let (x, z) = ((i * 37 % 1000) as f32 * 10.0, (i * 91 % 1000) as f32 * 10.0);
+        for y in [0.0, 599.0, 1601.0, 5000.0] {
+            assert_eq!(density_at(Vec3::new(x, y, z), &f, &D), 0.0);
+        }
+        let p = Vec3::new(x, 700.0, z);
+        assert_eq!(density_at(p, &e, &D), 0.0);
+        inside += usize::from(density_at(p, &f, &D) > 0.0);
+    }
+    assert!(
+        inside > 200,
+        "full coverage gives cloud somewhere ({inside} of 2000)"
+    );
+}
+
+/// The base is flat: across a cloud, density switches on within the
+/// same height ramp everywhere (BASE_RAMP of the band, 40 m here).
+#[test]
+fn cloud_base_is_flat() {
+    let cm = cloud_map();
+    let p = ProjectedField::uniform(32, 32, [1.0, 0.9, 1.0]);
+    let f = Fields {
+        p: &p,
+        cloud_map: &cm,
+    };
+    let ramp_m = BASE_RAMP * (D.band_top_m - D.band_bottom_m);
+    let mut onsets = Vec::new();
+    for i in 0..400 {
+        let (x, z) = (
+            (i % 20) as f32 * 500.0 + 13.0,
+            (i / 20) as f32 * 500.0 + 7.0,
+        );
+        let onset = (0..2000)
+            .map(|k| D.band_bottom_m + k as f32)
+            .find(|&y| density_at(Vec3::new(x, y, z), &f, &D) > 0.0);
+        if let Some(y) = onset {
+            onsets.push(y);
+        }
+    }
+    assert!(onsets.len() > 50);
+    let (lo, hi) = onsets
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &y| (a.min(y), b.max(y)));
+    // Onset varies by less than the ramp: 4 % of the band depth.
+    assert!(hi - lo <= ramp_m, "base from {lo} to {hi} m");
+}
+
+#[test]
+fn cloud_top_rises_with_the_parcel_height_channel() {
+    let cm = cloud_map();
+    let top_of = |h: f32| {
+        let p = ProjectedField::uniform(16, 16, [1.0, h, 1.0]);
+        let f = Fields {
+            p: &p,
+            cloud_map: &cm,
+        };
+        (0..400)
+            .map(|i| footprint((i % 20) as f32 / 20.0, (i / 20) as f32 / 20.0, &f, &D).1)
+            .fold(0.0, f32::max)
+    };
+    let (low, mid, high) = (top_of(0.1), top_of(0.5), top_of(1.0));
+    assert!(low < mid && mid < high, "{low} {mid} {high}");
+}
+
+#[test]
+fn band_segment_handles_camera_below_inside_and_above() {
+    let (b, t) = (600.0, 1600.0);
+    let up = Vec3::Y;
+    assert_eq!(
+        band_segment(Vec3::new(0.0, 0.0, 0.0), up, b, t, 1e5),
+        Some((600.0, 1600.0))
+    );
+    assert_eq!(
+        band_segment(Vec3::new(0.0, 1000.0, 0.0), up, b, t, 1e5),
+        Some((0.0, 600.0))
+    );
+    assert_eq!(
+        band_segment(Vec3::new(0.0, 2000.0, 0.0), -up, b, t, 1e5),
+        Some((400.0, 1400.0))
+    );
+    assert_eq!(
+        band_segment(Vec3::new(0.0, 2000.0, 0.0), up, b, t, 1e5),
+        None
+    );
+    assert_eq!(
+        band_segment(Vec3::new(0.0, 1000.0, 0.0), Vec3::X, b, t, 500.0),
+        Some((0.0, 500.0))
+    );
+}
+
+#[test]
+fn transmittance_is_in_unit_range_and_monotone_along_a_ray() {
+    let cm = cloud_map();
+    let p = ProjectedField::uniform(16, 16, [1.0, 1.0, 1.0]);
+    let f = Fields {
+        p: &p,
+        cloud_map: &cm,
+    };
+    let sun = Vec3::new(0.3, 0.8, 0.5).normalize();
+    let mut prev = 1.0;
+    // Walking toward the sun from deep below, less cloud lies ahead: the
+    // transmittance of what is left only grows.
+    for k in 0..50 {
+        let start = Vec3::new(1234.0, 500.0, 777.0) + sun * (k as f32 * 40.0);
+        let t = sun_transmittance(start, sun, 64, &f, &D);
+        assert!((0.0..=1.0).contains(&t));
+        if k > 0 {
+            assert!(t >= prev - 1e-6, "step {k}: {t} < {prev}");
+        }
+        prev = t;
+    }
+}
+
+/// Beer-Lambert tolerance: 1 % (the issue's).
+const BEER_LAMBERT_TOLERANCE: f32 = 0.01;
+
+#[test]
+fn constant_slab_transmittance_matches_beer_lambert() {
+    // A horizontally uniform slab (uniform P, under a cloud cell's middle)
+    // seen straight up: the renderer's transmittance must be the
+    // Beer-Lambert exp(-∫σ dy), the integral taken by a 200,000-point
+    // quadrature of the same density.
+    let cm = CloudMap::generate(&CloudMapConfig {
+        size: 16,
+        cells: 1.0,
+        ..CloudMapConfig::default()
+    });
+    let p = ProjectedField::uniform(8, 8, [1.0, 1.0, 1.0]);
+    let fields = Fields {
+        p: &p,
+        cloud_map: &cm,
+    };
+    let d = DensityParams {
+        extinction_per_m: 0.001,
+        ..D
+    };
+    // Under the middle of a cloud cell.
+    let (u, v) = cm.cell_centres(1)[0];
+    let origin = Vec3::new(u * d.map_extent_m, 0.0, v * d.map_extent_m);
+    // Numerical optical depth along the vertical with a fine quadrature.
+    let n = 200_000;
+    let dy = (d.band_top_m - d.band_bottom_m) / n as f32;
+    let tau: f64 = (0..n)
+        .map(|i| {
+            density_at(
+                origin + Vec3::Y * (d.band_bottom_m + (i as f32 + 0.5) * dy),
+                &fields,
+                &d,
+            ) as f64
+                * dy as f64
+        })
+        .sum();
+    assert!(tau > 0.1, "a real slab: τ = {tau}");
+    let frame = Frame {
+        camera: Camera {
+            position_m: origin,
+            yaw_deg: 0.0,
+            pitch_deg: 89.9,
+            fov_deg: 1.0,
+        },
+        sun_elevation_deg: 60.0,
+        sun_azimuth_deg: 0.0,
+        fields,
+        density: d,
+        quality: Quality {
+            steps: 2048,
+            shadow_steps: 0,
+            octaves: 0,
+            haze_distance_m: 1e9,
+            max_distance_m: 1e5,
+            exposure: 1.0,
+        },
+        terrain: None,
+    };
+    let s = march_ray(origin, Vec3::Y, 0.5, &frame);
+    let expected = (-tau).exp() as f32;
+    assert!(
+        (s.transmittance - expected).abs() / expected < BEER_LAMBERT_TOLERANCE,
+        "{} vs {expected}",
+        s.transmittance
+    );
+}
+
+fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
+    Frame {
+        camera: Camera {
+            position_m: Vec3::new(0.0, 100.0, 0.0),
+            yaw_deg: 30.0,
+            pitch_deg: 15.0,
+            fov_deg: 60.0,
+        },
+        sun_elevation_deg: 40.0,
+        sun_azimuth_deg: 135.0,
+        fields: Fields { p, cloud_map: cm },
+        density: D,
+        quality: Quality {
+            steps: 48,
+            shadow_steps: 4,
+            octaves: 2,
+            haze_distance_m: 25_000.0,
+            max_distance_m: 40_000.0,
+            exposure: 1.2,
+        },
+        terrain: None,
+    }
+}
+
+#[test]
+fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
+    let cm = cloud_map();
+    let p = ProjectedField::uniform(32, 32, [1.0, 0.8, 1.0]);
+    let fr = small_frame(&p, &cm);
+    let img = render_linear(96, 64, &fr);
+    assert!(img.iter().all(|c| c.is_finite()));
+    // Of the pixels looking up: sky is bluer than red, cloud nearly grey.
+    let up: Vec<Vec3> = img
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| {
+            fr.camera
+                .ray((k % 96) as f32 + 0.5, (k / 96) as f32 + 0.5, 96, 64)
+                .y
+                > 0.02
+        })
+        .map(|(_, c)| *c)
+        .collect();
+    let sky = up.iter().filter(|c| c.z > 1.3 * c.x).count();
+    let cloud = up.iter().filter(|c| c.z < 1.15 * c.x && c.x > 0.05).count();
+    assert!(
+        sky > 100 && cloud > 100,
+        "sky {sky}, cloud {cloud} of {}",
+        img.len()
+    );
+    let a = to_srgb8(&img, 1.2);
+    let b = to_srgb8(&render_linear(96, 64, &fr), 1.2);
+    assert_eq!(a, b, "same scene, same bytes");
+    // Without coverage the frame is all sky.
+    let empty = ProjectedField::uniform(32, 32, [0.0, 0.8, 1.0]);
+    let none = render_linear(96, 64, &small_frame(&empty, &cm));
+    let grey = none
+        .iter()
+        .enumerate()
+        .filter(|(k, c)| {
+            fr.camera
+                .ray((k % 96) as f32 + 0.5, (k / 96) as f32 + 0.5, 96, 64)
+                .y
+                > 0.02
+                && c.z < 1.15 * c.x
+        })
+        .count();
+    assert_eq!(grey, 0, "no cloud pixels without coverage");
+}
