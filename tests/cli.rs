@@ -302,3 +302,78 @@ fn sounding_flag_replaces_the_scene_atmosphere() {
     let thv: f64 = row[col].parse().unwrap();
     assert!((thv - 295.2).abs() < 1.0, "θ_v,env {thv}");
 }
+
+#[test]
+fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = root().join("scenes/fair_weather.toml");
+    let run = |name: &str| {
+        let out = dir.path().join(name);
+        let o = cumulus(&[
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "96",
+            "--height",
+            "72",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("backend: cpu"),
+            "says which backend it used"
+        );
+        std::fs::read(out).unwrap()
+    };
+    let (a, b) = (run("a.png"), run("b.png"));
+    assert_eq!(a, b, "same scene, same bytes");
+    let img = image::load_from_memory(&a).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (96, 72));
+    let upper = img.enumerate_pixels().filter(|(_, y, _)| *y < 24);
+    let (mut sky, mut cloud) = (0, 0);
+    for (_, _, p) in upper {
+        let [r, _, b] = p.0;
+        if b as f32 > 1.25 * r as f32 {
+            sky += 1
+        } else if r > 120 {
+            cloud += 1
+        }
+    }
+    assert!(sky > 100, "sky pixels: {sky}");
+    let all_cloud = img
+        .pixels()
+        .filter(|p| p.0[2] as f32 <= 1.15 * p.0[0] as f32 && p.0[0] > 120)
+        .count();
+    assert!(
+        all_cloud > 20,
+        "cloud pixels: {all_cloud} (upper third: {cloud})"
+    );
+
+    let out = dir.path().join("gpu.png");
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--backend",
+        "gpu",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--backend gpu"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--steps",
+        "0",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("render.steps"), "{}", stderr(&o));
+    assert!(!out.exists());
+}

@@ -16,6 +16,8 @@ const D: DensityParams = DensityParams {
     coverage: 0.75,
     extinction_per_m: 0.04,
     map_extent_m: 10_000.0,
+    detail_strength: 0.0,
+    detail_scale_m: 250.0,
 };
 
 fn cloud_map() -> CloudMap {

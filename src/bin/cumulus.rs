@@ -88,8 +88,13 @@ struct RenderArgs {
     #[arg(long)]
     scene: PathBuf,
     /// Output PNG (written atomically).
+    #[arg(long, required_unless_present = "quality_report")]
+    out: Option<PathBuf>,
+    /// Also write the error-against-cost report (render_quality.csv/.png)
+    /// into this directory: step counts from 8 to 256 against a 2048-step
+    /// reference, at up to 320x240.
     #[arg(long)]
-    out: PathBuf,
+    quality_report: Option<PathBuf>,
     /// Image width in pixels (overrides render.width).
     #[arg(long)]
     width: Option<u32>,
@@ -376,10 +381,9 @@ fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
 }
 
 fn render_cmd(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cloud_map::CloudMap;
-    use cumulus::render::cpu::density::{DensityParams, Fields};
-    use cumulus::render::cpu::renderer::{Frame, render_linear, to_srgb8};
-    use cumulus::sim::ProjectedField;
+    use cumulus::render::cpu::renderer::{render_linear, to_srgb8};
+    use cumulus::render::prepare::Prepared;
+    use cumulus::report::render_quality;
 
     let mut scene = load_scene(&a.scene)?;
     if let Some(w) = a.width {
@@ -401,54 +405,51 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
         bail!("--backend gpu: the wgpu renderer is not built yet; use --backend cpu (or auto)");
     }
     eprintln!("backend: cpu (the CPU reference renderer; no GPU backend is built yet)");
-    let atm = scene.atmosphere(None)?;
-    let band = scene.band(&atm);
-    let r = &scene.render;
-    let cloud_map = CloudMap::generate(&r.cloud_map);
-    let terrain = r
-        .terrain
-        .enabled
-        .then(|| cumulus::render::terrain::Heightfield::generate(&r.terrain));
-    let l = scene.physics.domain_size_m;
-    let sites = cloud_map
-        .cell_centres(64)
-        .into_iter()
-        .map(|(u, v)| glam::DVec2::new(u as f64 * l, v as f64 * l))
-        .collect();
-    let mut sim = Simulation::new(scene.physics.clone(), atm);
-    sim.set_spawn_sites(sites);
-    let frames = (r.time_s / scene.physics.dt_s).round() as u64;
-    let bar = progress_bar(frames, "simulating");
-    for _ in 0..frames {
-        sim.step();
-        bar.inc(1);
-    }
+    let bar = progress_bar(Prepared::frames(&scene), "simulating");
+    let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
-    let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
-    field.project(
-        sim.parcels(),
-        l,
-        band,
-        scene.physics.fill_full_condensed_fraction,
-    );
-    let frame = Frame {
-        camera: r.camera(),
-        sun_elevation_deg: r.sun_elevation_deg,
-        sun_azimuth_deg: r.sun_azimuth_deg,
-        fields: Fields {
-            p: &field,
-            cloud_map: &cloud_map,
-        },
-        density: DensityParams {
-            band_bottom_m: band.bottom_m as f32,
-            band_top_m: band.top_m as f32,
-            coverage: r.coverage,
-            extinction_per_m: r.extinction_per_m,
-            map_extent_m: l as f32,
-        },
-        quality: r.quality(),
-        terrain: terrain.as_ref(),
-    };
+    let r = &scene.render;
+    let frame = prepared.frame(r, r.quality());
+    if let Some(dir) = &a.quality_report {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+        let (w, h) = (r.width.min(320), r.height.min(240));
+        let bar = progress_bar(render_quality::STEPS.len() as u64 + 1, "rendering");
+        let report = render_quality::measure(&frame, w, h, &render_quality::STEPS, || bar.inc(1));
+        bar.finish_and_clear();
+        render_quality::write(&report, dir)?;
+        println!(
+            "reference ({} steps) took {:.2} s at {w}x{h}",
+            render_quality::REFERENCE_STEPS,
+            report.reference_wall_s
+        );
+        println!(
+            "{:>6} {:>9} {:>11} {:>10}",
+            "steps", "wall_s", "mean_error", "max_error"
+        );
+        for row in &report.rows {
+            println!(
+                "{:>6} {:>9.4} {:>11.5} {:>10.4}",
+                row.steps, row.wall_s, row.mean_error, row.max_error
+            );
+        }
+        match report.chosen {
+            Some(i) => println!(
+                "least-cost step count with mean error <= {}: {}",
+                render_quality::TARGET_MEAN_ERROR,
+                report.rows[i].steps
+            ),
+            None => println!(
+                "no step count reached mean error <= {}",
+                render_quality::TARGET_MEAN_ERROR
+            ),
+        }
+        println!(
+            "wrote {0}/render_quality.csv and {0}/render_quality.png",
+            dir.display()
+        );
+    }
+    let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
     let linear = render_linear(r.width, r.height, &frame);
     let elapsed = start.elapsed();
@@ -456,8 +457,8 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
     let img = image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    write_atomically(&a.out, |w| w.write_all(&png))
-        .with_context(|| format!("{}: cannot write image", a.out.display()))?;
+    write_atomically(out, |w| w.write_all(&png))
+        .with_context(|| format!("{}: cannot write image", out.display()))?;
     eprintln!(
         "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
@@ -466,10 +467,10 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
         r.steps,
         r.shadow_steps,
         r.octaves,
-        100.0 * field.covered_fraction(),
-        band.bottom_m,
-        band.top_m,
-        a.out.display()
+        100.0 * prepared.field.covered_fraction(),
+        prepared.band.bottom_m,
+        prepared.band.top_m,
+        out.display()
     );
     Ok(())
 }

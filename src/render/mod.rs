@@ -3,4 +3,5 @@
 
 pub mod cloud_map;
 pub mod cpu;
+pub mod prepare;
 pub mod terrain;

@@ -4,6 +4,7 @@
 pub mod convergence;
 pub mod curves;
 pub mod plot;
+pub mod render_quality;
 
 /// What went wrong writing a report.
 #[derive(Debug, thiserror::Error)]

@@ -64,6 +64,9 @@ pub fn pixel_dither(x: u32, y: u32) -> f32 {
     f(52.982_918 * f(0.067_110_56 * x as f32 + 0.005_837_15 * y as f32))
 }
 
+/// Sub-samples of a coarse march interval that touches cloud.
+pub const REFINE: u32 = 4;
+
 /// Relative sun irradiance: sunlight is about five times the sky's
 /// illuminance on a clear day, so a sunlit cloud is brighter than the sky.
 pub const SUN_INTENSITY: f32 = 8.0;
@@ -102,25 +105,41 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
     let mut depth_weighted = 0.0_f32;
-    for i in 0..steps {
-        let t = t0 + (i as f32 + dither) * dt;
-        let p = origin + dir * t;
-        let sigma_t = density_at(p, &fr.fields, d);
-        if sigma_t <= 0.0 {
-            continue;
-        }
-        let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, &fr.fields, d);
-        let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        // Sky light from above, darker toward the cloud base.
-        let ambient = ambient_top * (0.35 + 0.65 * eta);
-        let scatter = sun * sun_scattering(tau_sun, cos, q.octaves) + ambient;
-        let s = scatter * (sigma_t * ALBEDO);
-        let step_t = (-sigma_t * dt).exp();
-        light += integrate_step(s, sigma_t, dt) * transmittance;
-        depth_weighted += t * transmittance * (1.0 - step_t);
-        transmittance *= step_t;
-        if transmittance < MIN_TRANSMITTANCE {
-            break;
+    // Coarse intervals of `dt`; an interval whose ends touch cloud is
+    // sampled REFINE times finer (the dither places the samples), so thin
+    // cloud edges seen at grazing angles get several samples, and empty sky
+    // costs one density lookup per interval.
+    let mut sigma_a = density_at(origin + dir * t0, &fr.fields, d);
+    'march: for i in 0..steps {
+        let ta = t0 + i as f32 * dt;
+        let sigma_b = density_at(origin + dir * (ta + dt), &fr.fields, d);
+        let touched = sigma_a > 0.0 || sigma_b > 0.0;
+        sigma_a = sigma_b;
+        let (n, h) = if touched {
+            (REFINE, dt / REFINE as f32)
+        } else {
+            (1, dt)
+        };
+        for j in 0..n {
+            let t = ta + (j as f32 + dither) * h;
+            let p = origin + dir * t;
+            let sigma_t = density_at(p, &fr.fields, d);
+            if sigma_t <= 0.0 {
+                continue;
+            }
+            let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, &fr.fields, d);
+            let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
+            // Sky light from above, darker toward the cloud base.
+            let ambient = ambient_top * (0.35 + 0.65 * eta);
+            let scatter = sun * sun_scattering(tau_sun, cos, q.octaves) + ambient;
+            let s = scatter * (sigma_t * ALBEDO);
+            let step_t = (-sigma_t * h).exp();
+            light += integrate_step(s, sigma_t, h) * transmittance;
+            depth_weighted += t * transmittance * (1.0 - step_t);
+            transmittance *= step_t;
+            if transmittance < MIN_TRANSMITTANCE {
+                break 'march;
+            }
         }
     }
     let opacity = 1.0 - transmittance;
@@ -178,6 +197,10 @@ pub fn terrain_radiance(
 pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
     let Some((t0, t1)) = band_segment(p, sun_dir, d.band_bottom_m, d.band_top_m, 20_000.0) else {
         return 1.0;
+    };
+    let d = &DensityParams {
+        detail_strength: 0.0,
+        ..*d
     };
     let dt = (t1 - t0) / steps.max(1) as f32;
     let tau: f32 = (0..steps.max(1))
@@ -249,7 +272,13 @@ pub struct RenderSettings {
     pub coverage: f32,
     /// Extinction of the densest cloud, 1/m (> 0). Default 0.04.
     pub extinction_per_m: f32,
-    /// Primary march steps (1..=4096). Default 128.
+    /// Strength of the 3D detail noise eroding edges, 0..=1 (0: off, not
+    /// evaluated). Default 0.5.
+    pub detail_strength: f32,
+    /// Size of the detail noise's features, m (> 0). Default 250.
+    pub detail_scale_m: f32,
+    /// Primary march steps (1..=4096). Default 48 (chosen from
+    /// `cumulus render --quality-report`, see README).
     pub steps: u32,
     /// Shadow march steps toward the sun (0..=64; 0 = off). Default 6.
     pub shadow_steps: u32,
@@ -282,7 +311,9 @@ impl Default for RenderSettings {
             sun_azimuth_deg: 135.0,
             coverage: 0.75,
             extinction_per_m: 0.04,
-            steps: 128,
+            detail_strength: 0.5,
+            detail_scale_m: 250.0,
+            steps: 48,
             shadow_steps: 6,
             octaves: 2,
             haze_distance_m: 25_000.0,

@@ -1,0 +1,86 @@
+//! From a scene to what a frame needs: simulate, project P, generate the
+//! cloud map (and terrain), place parcels on the map's cells.
+
+use crate::render::cloud_map::CloudMap;
+use crate::render::cpu::density::{DensityParams, Fields};
+use crate::render::cpu::renderer::{Frame, Quality, RenderSettings};
+use crate::render::terrain::Heightfield;
+use crate::scene::{Scene, SceneError};
+use crate::sim::{Band, ProjectedField, Simulation};
+
+/// A scene's textures at one moment.
+pub struct Prepared {
+    pub field: ProjectedField,
+    pub cloud_map: CloudMap,
+    pub terrain: Option<Heightfield>,
+    pub band: Band,
+    pub map_extent_m: f64,
+}
+
+impl Prepared {
+    /// Simulates `scene.render.time_s` seconds (calling `progress` after
+    /// each frame) with parcels born on the cloud map's cells (the paper's
+    /// Alg. 1, line 2), then projects P.
+    pub fn from_scene(scene: &Scene, mut progress: impl FnMut()) -> Result<Self, SceneError> {
+        let atm = scene.atmosphere(None)?;
+        let band = scene.band(&atm);
+        let r = &scene.render;
+        let cloud_map = CloudMap::generate(&r.cloud_map);
+        let terrain = r.terrain.enabled.then(|| Heightfield::generate(&r.terrain));
+        let l = scene.physics.domain_size_m;
+        let sites = cloud_map
+            .cell_centres(64)
+            .into_iter()
+            .map(|(u, v)| glam::DVec2::new(u as f64 * l, v as f64 * l))
+            .collect();
+        let mut sim = Simulation::new(scene.physics.clone(), atm);
+        sim.set_spawn_sites(sites);
+        for _ in 0..Self::frames(scene) {
+            sim.step();
+            progress();
+        }
+        let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
+        field.project(
+            sim.parcels(),
+            l,
+            band,
+            scene.physics.fill_full_condensed_fraction,
+        );
+        Ok(Self {
+            field,
+            cloud_map,
+            terrain,
+            band,
+            map_extent_m: l,
+        })
+    }
+
+    /// Physics frames simulated before the picture.
+    pub fn frames(scene: &Scene) -> u64 {
+        (scene.render.time_s / scene.physics.dt_s).round() as u64
+    }
+
+    /// The frame for `settings` with `quality`.
+    pub fn frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
+        Frame {
+            camera: r.camera(),
+            sun_elevation_deg: r.sun_elevation_deg,
+            sun_azimuth_deg: r.sun_azimuth_deg,
+            fields: Fields {
+                p: &self.field,
+                cloud_map: &self.cloud_map,
+            },
+            density: DensityParams {
+                band_bottom_m: self.band.bottom_m as f32,
+                band_top_m: self.band.top_m as f32,
+                coverage: r.coverage,
+                extinction_per_m: r.extinction_per_m,
+                map_extent_m: self.map_extent_m as f32,
+                detail_strength: r.detail_strength,
+                detail_scale_m: r.detail_scale_m,
+            },
+            quality,
+            terrain: self.terrain.as_ref(),
+        }
+    }
+}
