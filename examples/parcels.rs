@@ -25,10 +25,11 @@ fn main() {
         bottom_m: 600.0,
         top_m: 1600.0,
     };
+    let frames_per_minute = (60.0 / sim.config().dt_s).round().max(1.0) as usize;
     let start = std::time::Instant::now();
     for minute in 1..=60 {
         let mut substeps = 0;
-        for _ in 0..12 {
+        for _ in 0..frames_per_minute {
             substeps += sim.step().substeps;
         }
         field.project(
@@ -52,7 +53,7 @@ fn main() {
                 sim.time_s(),
                 p.len(),
                 100.0 * field.covered_fraction(),
-                substeps as f64 / 12.0
+                substeps as f64 / frames_per_minute as f64
             );
         }
     }
