@@ -1,12 +1,13 @@
 //! Lifting a surface parcel without mixing (what MetPy's `parcel_profile`
-//! does): dry adiabat to the lifting condensation level, then a moist
-//! adiabat, either pseudo-adiabatic (condensate falls out) or reversible
-//! (condensate carried, `θ_l` and `q_t` conserved).
+//! does): the unsaturated adiabat of the moist air to the lifting
+//! condensation level (Romps 2017), then a moist adiabat, either
+//! pseudo-adiabatic (condensate falls out) or reversible (condensate
+//! carried, `θ_l` and `q_t` conserved).
 
 use serde::{Deserialize, Serialize};
 
 use super::atmosphere::Atmosphere;
-use super::constants::{C_P, EPSILON, G, KAPPA, L_V, R_D, VIRTUAL_COEFF};
+use super::constants::{C_P, EPSILON, G, L_V, R_D, R_V, VIRTUAL_COEFF};
 use super::sounding::Sounding;
 use super::thermo::{dewpoint, exner, saturation_adjust, saturation_mixing_ratio};
 
@@ -30,9 +31,23 @@ pub struct Lcl {
     pub temperature_k: f64,
 }
 
-/// LCL of air at `t_k`, vapour mixing ratio `qv`, pressure `p_pa`: where the
-/// dry adiabat meets the dewpoint of the conserved mixing ratio. Solved by
-/// bisection to 1e-6 Pa. Saturated (or supersaturated) air is at its LCL.
+/// Specific heat of water vapour at constant pressure, J/(kg K) (MetPy's).
+const C_PV: f64 = 1860.078_011_865_639;
+
+/// Poisson exponent `R_m / c_pm` of moist air with vapour mixing ratio `qv`
+/// (Romps 2017): the unsaturated adiabat of air that carries its vapour.
+pub fn moist_air_kappa(qv: f64) -> f64 {
+    let q = qv / (1.0 + qv);
+    ((1.0 - q) * R_D + q * R_V) / ((1.0 - q) * C_P + q * C_PV)
+}
+
+/// LCL of air at `t_k`, vapour mixing ratio `qv`, pressure `p_pa`: where its
+/// unsaturated adiabat, `T (p/p_0)^(R_m/c_pm)` with the moist air's own gas
+/// constant and heat capacity, meets the dewpoint of the conserved mixing
+/// ratio. This is the problem Romps (2017) solves in closed form (MetPy's
+/// `lcl` since 1.6); here by bisection to 1e-6 Pa. With the dry `κ` the LCL
+/// of hot, humid air was up to 17 m too low. Saturated (or supersaturated)
+/// air is at its LCL.
 pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
     let Some(td0) = dewpoint(qv, p_pa) else {
         // Dry air never condenses: report the top of the atmosphere.
@@ -47,7 +62,8 @@ pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
             temperature_k: t_k,
         };
     }
-    let gap = |p: f64| t_k * (p / p_pa).powf(KAPPA) - dewpoint(qv, p).unwrap_or(0.0);
+    let kappa = moist_air_kappa(qv);
+    let gap = |p: f64| t_k * (p / p_pa).powf(kappa) - dewpoint(qv, p).unwrap_or(0.0);
     let (mut lo, mut hi) = (1.0_f64, p_pa);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
@@ -63,7 +79,7 @@ pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
     let p = 0.5 * (lo + hi);
     Lcl {
         pressure_pa: p,
-        temperature_k: t_k * (p / p_pa).powf(KAPPA),
+        temperature_k: t_k * (p / p_pa).powf(kappa),
     }
 }
 
@@ -140,7 +156,11 @@ pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
         .map(|(i, l)| {
             let p = p_of(i);
             let (t, qv, qc) = if p >= lcl.pressure_pa {
-                (t0 * (p / p0).powf(KAPPA), q0v, 0.0)
+                // The unsaturated adiabat of the moist air (Romps 2017), the
+                // same one the LCL lies on, so the profile is continuous
+                // there. (MetPy's parcel_profile uses the dry κ here and so
+                // starts its moist adiabat ~0.1 K colder than its own LCL.)
+                (t0 * (p / p0).powf(moist_air_kappa(q0v)), q0v, 0.0)
             } else {
                 match adiabat {
                     Adiabat::Pseudo => {
@@ -197,7 +217,7 @@ mod tests {
         let q = saturation_mixing_ratio(290.0, p);
         let l = lcl(t, q, p);
         let td = dewpoint(q, l.pressure_pa).expect("moist");
-        assert!((l.temperature_k - td).abs() < 1e-4);
+        assert!((l.temperature_k - td).abs() < 1e-4, "{l:?} td {td}");
         // Bolton (1980) Eq. 15 estimate of T_LCL agrees within 0.1 K.
         let bolton = 1.0 / (1.0 / (290.0 - 56.0) + (300.0_f64 / 290.0).ln() / 800.0) + 56.0;
         assert!(

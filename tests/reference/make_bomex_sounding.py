@@ -9,8 +9,9 @@ initial profile is unsaturated, so theta = theta_l and q_v = q_t.
 
 Pressure is integrated hydrostatically (dp/dz = -p g / (R_d T_v)) on a 1 m
 grid with the same constants as src/sim/constants.rs; the dewpoint inverts
-Bolton's (1980) saturation vapour pressure, as src/sim/thermo.rs does. Pure
-Python, no packages: run `python3 tests/reference/make_bomex_sounding.py`.
+Ambaum's (2020) saturation vapour pressure, as src/sim/thermo.rs does, so
+the mixing ratio read back is the case's q_t. Pure Python, no packages:
+run `python3 tests/reference/make_bomex_sounding.py`.
 """
 import math
 import os
@@ -31,10 +32,22 @@ def interp(table, z):
     raise ValueError(z)
 
 
+CP_L, CP_V, RV_A, L0, T0 = 4219.4, 1860.078011865639, 461.52311572606084, 2.50084e6, 273.16
+
+
+def es_ambaum(t):
+    lat = L0 - (CP_L - CP_V) * (t - T0)
+    return 611.2 * (T0 / t) ** ((CP_L - CP_V) / RV_A) * math.exp((L0 / T0 - lat / t) / RV_A)
+
+
 def dewpoint_c(q, p):
     e = q * p / (EPS + q)
     ln = math.log(e / 611.2)
-    return 243.5 * ln / (17.67 - ln)
+    t = 273.15 + 243.5 * ln / (17.67 - ln)
+    for _ in range(20):
+        lat = L0 - (CP_L - CP_V) * (t - T0)
+        t -= (math.log(es_ambaum(t)) - math.log(e)) / (lat / (RV_A * t * t))
+    return t - 273.15
 
 
 def main():
