@@ -344,12 +344,20 @@ fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
         report.reference_dt_s, report.reference_wall_s
     );
     println!(
-        "{:>8} {:>9} {:>9} {:>9} {:>10} {:>10} {:>9} {:>9}",
-        "dt_s", "wall_s", "err_z_m", "err_w", "err_thv_K", "err_qc_gkg", "base_m", "top_m"
+        "{:>8} {:>9} {:>9} {:>9} {:>10} {:>10} {:>9} {:>9} {:>9}",
+        "dt_s",
+        "wall_s",
+        "err_z_m",
+        "err_w",
+        "err_thv_K",
+        "err_qc_gkg",
+        "base_m",
+        "top_m",
+        "other_life"
     );
     for r in &report.rows {
         println!(
-            "{:>8} {:>9.4} {:>9.3} {:>9.4} {:>10.4} {:>10.5} {:>9.2} {:>9.2}",
+            "{:>8} {:>9.4} {:>9.3} {:>9.4} {:>10.4} {:>10.5} {:>9.2} {:>9.2} {:>9.3}",
             r.dt_s,
             r.wall_s,
             r.err_z_m,
@@ -357,14 +365,16 @@ fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
             r.err_theta_v_k,
             r.err_qc_gkg,
             r.err_cloud_base_m,
-            r.err_cloud_top_m
+            r.err_cloud_top_m,
+            r.life_mismatch
         );
     }
     match report.chosen {
         Some(i) => println!(
-            "least-cost step reaching RMS z error <= {} m and q_c error <= {} g/kg: dt = {} s",
+            "least-cost step reaching RMS z error <= {} m, q_c error <= {} g/kg and other-life fraction <= {}: dt = {} s",
             convergence::TARGET_Z_M,
             convergence::TARGET_QC_GKG,
+            convergence::TARGET_LIFE_MISMATCH,
             report.rows[i].dt_s
         ),
         None => println!(

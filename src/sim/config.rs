@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
-    /// Frame time step, s. Domain 1e-3..=600. Default 2 (chosen from
+    /// Frame time step, s. Domain 1e-3..=600. Default 5 (chosen from
     /// `cumulus convergence`, see README).
     pub dt_s: f64,
     /// Number of parcels. Domain 0..=200000. Default 12 (as in the paper).
@@ -57,7 +57,7 @@ pub struct PhysicsConfig {
 impl Default for PhysicsConfig {
     fn default() -> Self {
         Self {
-            dt_s: 2.0,
+            dt_s: 5.0,
             parcels: 12,
             seed: 1,
             domain_size_m: 10_000.0,

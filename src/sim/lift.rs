@@ -32,7 +32,7 @@ pub struct Lcl {
 }
 
 /// Specific heat of water vapour at constant pressure, J/(kg K) (MetPy's).
-const C_PV: f64 = 1860.078_011_865_639;
+const C_PV: f64 = 1_860.078_011_865_639;
 
 /// Poisson exponent `R_m / c_pm` of moist air with vapour mixing ratio `qv`
 /// (Romps 2017): the unsaturated adiabat of air that carries its vapour.

@@ -23,8 +23,8 @@ pub fn exner(p_pa: f64) -> f64 {
 mod ambaum {
     pub const E0_PA: f64 = 611.2;
     pub const T0_K: f64 = 273.16;
-    pub const CP_L: f64 = 4219.4;
-    pub const CP_V: f64 = 1860.078_011_865_639;
+    pub const CP_L: f64 = 4_219.4;
+    pub const CP_V: f64 = 1_860.078_011_865_639;
     pub const R_V: f64 = 461.523_115_726_060_84;
     pub const L0: f64 = 2.500_84e6;
 }
