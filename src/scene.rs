@@ -95,7 +95,7 @@ pub struct Scene {
 
 /// A range check for one key.
 struct Check<'a> {
-    key: &'a str,
+    key: std::borrow::Cow<'a, str>,
     ok: bool,
     expected: &'a str,
     value: String,
@@ -133,8 +133,8 @@ impl Scene {
     /// when the scene came from a file, the line.
     pub fn validate(&self) -> Result<(), SceneError> {
         let p = &self.physics;
-        let c = |key, ok, expected, value: f64| Check {
-            key,
+        let c = |key: &'static str, ok, expected, value: f64| Check {
+            key: key.into(),
             ok,
             expected,
             value: value.to_string(),
@@ -500,7 +500,7 @@ impl Scene {
         ));
         if let (Some(b), Some(t)) = (self.projection.band_bottom_m, self.projection.band_top_m) {
             checks.push(Check {
-                key: "projection.band_top_m",
+                key: "projection.band_top_m".into(),
                 ok: t > b,
                 expected: "above band_bottom_m",
                 value: t.to_string(),
@@ -583,7 +583,7 @@ impl Scene {
             ];
             for (name, v, lo, hi, expected) in list {
                 checks.push(Check {
-                    key: Box::leak(format!("{k}{name}").into_boxed_str()),
+                    key: format!("{k}{name}").into(),
                     ok: finite_in(v, lo, hi),
                     expected,
                     value: v.to_string(),
@@ -591,7 +591,7 @@ impl Scene {
             }
             if self.atmosphere.sounding.is_some() {
                 checks.push(Check {
-                    key: "atmosphere.sounding",
+                    key: "atmosphere.sounding".into(),
                     ok: false,
                     expected: "either a sounding or [atmosphere.parametric], not both",
                     value: "both given".into(),
@@ -600,7 +600,9 @@ impl Scene {
         }
         match checks.into_iter().find(|c| !c.ok) {
             None => Ok(()),
-            Some(c) => Err(self.invalid(c.key, format!("is {}, expected {}", c.value, c.expected))),
+            Some(c) => {
+                Err(self.invalid(&c.key, format!("is {}, expected {}", c.value, c.expected)))
+            }
         }
     }
 

@@ -2,7 +2,7 @@
 //! clear error (file, line, key), a non-zero exit, no panic and no output
 //! file.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn cumulus(args: &[&str]) -> Output {
@@ -271,7 +271,6 @@ fn scene_check_accepts_shipped_scenes_and_rejects_bad_ones() {
         "{}",
         stderr(&o)
     );
-    let _ = Path::new("");
 }
 
 #[test]
