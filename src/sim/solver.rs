@@ -144,23 +144,33 @@ impl Simulation {
         self.sites = sites;
         for i in 0..self.parcels.len() {
             if !self.parcels.life[i].released() {
+                // Still waiting: re-place it, keeping its release time.
                 let age = self.parcels.life[i].age_s;
-                let generation = self.parcels.life[i].generation;
-                let before = self.parcels.qt[i] * self.parcels.life[i].mass_kg;
-                spawn(
-                    &self.cfg,
-                    &self.atm,
-                    &self.sites,
-                    &mut self.parcels,
-                    i,
-                    generation,
-                );
+                self.respawn(i, self.parcels.life[i].generation);
                 self.parcels.life[i].age_s = age;
-                let after = self.parcels.qt[i] * self.parcels.life[i].mass_kg;
-                self.retired_detrained.add(before);
-                self.retired_entrained.add(after);
             }
         }
+    }
+
+    /// Re-births parcel `i` as life `generation`: its water and its life's
+    /// exchange are retired to the books, the new air's water is drawn from
+    /// the environment. The one place a re-birth touches the water books.
+    fn respawn(&mut self, i: usize, generation: u32) {
+        let life = self.parcels.life[i];
+        self.retired_detrained.merge(&life.detrained_kg);
+        self.retired_entrained.merge(&life.entrained_kg);
+        self.retired_detrained
+            .add(self.parcels.qt[i] * life.mass_kg);
+        spawn(
+            &self.cfg,
+            &self.atm,
+            &self.sites,
+            &mut self.parcels,
+            i,
+            generation,
+        );
+        self.retired_entrained
+            .add(self.parcels.qt[i] * self.parcels.life[i].mass_kg);
     }
 
     /// Places parcels explicitly (released, at rest relative to the wind,
@@ -401,28 +411,14 @@ impl Simulation {
 
     /// Re-births spent parcels; returns how many.
     fn recycle(&mut self) -> usize {
-        let r = &self.cfg.recycling;
+        let r = self.cfg.recycling.clone();
         let mut count = 0;
         for i in 0..self.parcels.len() {
             let life = self.parcels.life[i];
             let qc = self.parcels.diag[i].qc;
             let decayed = life.peak_qc > QC_EPS && qc < r.spent_fraction_of_peak * life.peak_qc;
             if life.released() && (decayed || life.age_s > r.max_age_s) {
-                // Hand back the parcel's water, retire its books, re-birth.
-                self.retired_detrained.merge(&life.detrained_kg);
-                self.retired_entrained.merge(&life.entrained_kg);
-                self.retired_detrained
-                    .add(self.parcels.qt[i] * life.mass_kg);
-                spawn(
-                    &self.cfg,
-                    &self.atm,
-                    &self.sites,
-                    &mut self.parcels,
-                    i,
-                    life.generation + 1,
-                );
-                let l = &self.parcels.life[i];
-                self.retired_entrained.add(self.parcels.qt[i] * l.mass_kg);
+                self.respawn(i, life.generation + 1);
                 count += 1;
             }
         }
