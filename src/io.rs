@@ -38,3 +38,11 @@ pub fn write_atomically(
     }
     result
 }
+
+/// Encodes an RGB image as PNG and writes it atomically.
+pub fn write_png_atomically(path: &Path, img: &image::RgbImage) -> std::io::Result<()> {
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(std::io::Error::other)?;
+    write_atomically(path, |out| out.write_all(&png))
+}

@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use cumulus::io::write_atomically;
+use cumulus::io::{write_atomically, write_png_atomically};
 use cumulus::report::{convergence, curves};
 use cumulus::scene::Scene;
 use cumulus::sim::lift::{Adiabat, lift_sounding};
@@ -465,9 +465,7 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
     let elapsed = start.elapsed();
     let bytes = to_srgb8(&linear, r.exposure);
     let img = image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    write_atomically(out, |w| w.write_all(&png))
+    write_png_atomically(out, &img)
         .with_context(|| format!("{}: cannot write image", out.display()))?;
     eprintln!(
         "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",

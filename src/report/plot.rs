@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 use super::ReportError;
-use crate::io::write_atomically;
+use crate::io::write_png_atomically;
 
 static FONT: &[u8] = include_bytes!("DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
@@ -118,10 +118,7 @@ pub fn loglog_png(
         root.present().map_err(|e| err(&e))?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| err(&"buffer size"))?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| err(&e))?;
-    write_atomically(path, |out| out.write_all(&png)).map_err(|source| ReportError::Write {
+    write_png_atomically(path, &img).map_err(|source| ReportError::Write {
         path: path.to_owned(),
         source,
     })

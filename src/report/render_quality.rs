@@ -9,7 +9,7 @@ use glam::Vec3;
 use super::ReportError;
 use super::plot::{Series, loglog_png};
 use crate::io::write_atomically;
-use crate::render::cpu::renderer::{Frame, render_linear};
+use crate::render::cpu::renderer::{Frame, render_linear, tone_map};
 
 /// Step counts measured.
 pub const STEPS: [u32; 9] = [8, 16, 24, 32, 48, 64, 96, 128, 256];
@@ -41,7 +41,11 @@ pub struct Report {
 }
 
 fn tone(c: Vec3, exposure: f32) -> Vec3 {
-    Vec3::ONE - (-c.max(Vec3::ZERO) * exposure).exp()
+    Vec3::new(
+        tone_map(c.x, exposure),
+        tone_map(c.y, exposure),
+        tone_map(c.z, exposure),
+    )
 }
 
 /// Renders `frame` at every count in `steps` and at the reference.

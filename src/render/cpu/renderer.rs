@@ -230,10 +230,17 @@ pub fn render_linear(width: u32, height: u32, fr: &Frame) -> Vec<Vec3> {
     out
 }
 
-/// Tone map (`1 - e^{-x·exposure}`) and sRGB-encode to 8 bits.
+/// The tone map, `1 - e^{-x·exposure}`: linear radiance to display `0..1`.
+/// The images and the quality report both use it.
+#[inline]
+pub fn tone_map(c: f32, exposure: f32) -> f32 {
+    1.0 - (-c.max(0.0) * exposure).exp()
+}
+
+/// Tone map ([`tone_map`]) and sRGB-encode to 8 bits.
 pub fn to_srgb8(linear: &[Vec3], exposure: f32) -> Vec<u8> {
     let enc = |c: f32| {
-        let x = 1.0 - (-c.max(0.0) * exposure).exp();
+        let x = tone_map(c, exposure);
         let s = if x <= 0.003_130_8 {
             12.92 * x
         } else {
