@@ -419,6 +419,12 @@ impl Scene {
                 r.time_s,
             ),
             c(
+                "render.tsaa_blend",
+                finite_in(f(r.tsaa_blend), 1e-3, 1.0),
+                "0.001..=1",
+                f(r.tsaa_blend),
+            ),
+            c(
                 "render.cloud_map.size",
                 (16..=2048).contains(&r.cloud_map.size),
                 "16..=2048 texels",

@@ -121,7 +121,12 @@ impl CloudMap {
         self.size
     }
 
-    /// The texels, row-major.
+    /// The texel at column `x`, row `y`.
+    pub fn texel(&self, x: usize, y: usize) -> [f32; 2] {
+        self.texels[y * self.size + x]
+    }
+
+    /// All texels, row-major.
     pub fn texels(&self) -> &[[f32; 2]] {
         &self.texels
     }

@@ -2,6 +2,8 @@
 //! and fallback that the wgpu renderer will be tested against).
 
 pub mod cloud_map;
+pub mod coverage_mask;
 pub mod cpu;
+pub mod gpu;
 pub mod prepare;
 pub mod terrain;

@@ -4,6 +4,7 @@
 use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::density::{DensityParams, Fields};
 use crate::render::cpu::renderer::{Frame, Quality, RenderSettings};
+use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::Heightfield;
 use crate::scene::{Scene, SceneError};
 use crate::sim::{Band, ProjectedField, Simulation};
@@ -58,6 +59,21 @@ impl Prepared {
     /// Physics frames simulated before the picture.
     pub fn frames(scene: &Scene) -> u64 {
         (scene.render.time_s / scene.physics.dt_s).round() as u64
+    }
+
+    /// The GPU renderer's settings for `r` with `quality`.
+    pub fn gpu_settings(&self, r: &RenderSettings, quality: Quality) -> GpuSettings {
+        let f = self.frame(r, quality);
+        GpuSettings {
+            density: f.density,
+            quality,
+            sun_elevation_deg: r.sun_elevation_deg,
+            sun_azimuth_deg: r.sun_azimuth_deg,
+            tsaa: r.tsaa.then_some(TsaaSettings {
+                blend: r.tsaa_blend,
+            }),
+            debug_sample_count: false,
+        }
     }
 
     /// The frame for `settings` with `quality`.

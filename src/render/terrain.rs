@@ -85,6 +85,21 @@ impl Heightfield {
         }
     }
 
+    /// Texels per side.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// Heights, m, row-major (`size²`).
+    pub fn heights(&self) -> &[f32] {
+        &self.heights
+    }
+
+    /// Side of the texture, m.
+    pub fn extent_m(&self) -> f32 {
+        self.extent_m
+    }
+
     /// Highest point, m.
     pub fn max_m(&self) -> f32 {
         self.max_m

@@ -299,6 +299,11 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Physics seconds simulated before the picture (>= 0). Default 2400.
     pub time_s: f64,
+    /// Temporal anti-aliasing on the GPU (the CPU reference never jitters).
+    /// Off: no jitter, no history textures, no TSAA pass. Default true.
+    pub tsaa: bool,
+    /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
+    pub tsaa_blend: f32,
     /// The cloud map (`[render.cloud_map]`).
     pub cloud_map: crate::render::cloud_map::CloudMapConfig,
     /// The terrain (`[render.terrain]`), off by default.
@@ -327,6 +332,8 @@ impl Default for RenderSettings {
             max_distance_m: 40_000.0,
             exposure: 1.2,
             time_s: 2400.0,
+            tsaa: true,
+            tsaa_blend: 0.1,
             cloud_map: Default::default(),
             terrain: TerrainConfig::default(),
         }

@@ -1,0 +1,411 @@
+// The cloud pass: a full-screen fragment shader that ray-casts the cloud
+// height band through P (coverage, normalised height, fill) and the cloud
+// map CM. Every function here has a twin of the same name in
+// src/render/cpu/ (density.rs, lighting.rs, sky.rs, renderer.rs); the
+// parity tests render both and compare. Keep them in step.
+//
+// The entry points are appended by src/render/gpu/shaders.rs, one per
+// variant (with or without a depth buffer, with or without the TSAA
+// distance output), so a variant that a scene does not need is not built.
+
+// Pipeline-overridable constants: features that are off are folded away
+// by the shader compiler, so they cost nothing.
+override SHADOW_STEPS: u32 = 6u;
+override OCTAVES: u32 = 2u;
+override DETAIL: bool = true;
+override DEBUG_COUNT: bool = false;
+
+const PI: f32 = 3.14159265358979;
+const BASE_RAMP: f32 = 0.04;
+const REFINE: u32 = 4u;
+const ALBEDO: f32 = 0.99;
+const MIN_TRANSMITTANCE: f32 = 0.01;
+const SUN_DISK_COS: f32 = 0.999989;
+
+// Mirrors `FrameUniforms` in src/render/gpu/uniforms.rs (352 bytes).
+struct Frame {
+    cam_pos: vec4f,      // xyz, tan(fov / 2)
+    cam_forward: vec4f,  // xyz, aspect
+    cam_right: vec4f,    // xyz, width in pixels
+    cam_up: vec4f,       // xyz, height in pixels
+    sun_dir: vec4f,      // xyz, haze distance (m)
+    sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
+    ambient_top: vec4f,  // sky_radiance(up) / 4, exposure
+    sky_up: vec4f,       // sky_radiance(up), unused
+    band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
+    map: vec4f,          // extent (m), detail strength, detail scale (m), unused
+    jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
+    depth: vec4f,        // near, far (m), terrain extent (m), terrain max (m)
+    counts: vec4u,       // steps, P width, P height, frame index
+    mask: vec4u,         // mask width, height, P texels per mask cell, unused
+    view_proj: mat4x4f,
+    prev_view_proj: mat4x4f,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var p_tex: texture_2d<f32>;
+@group(0) @binding(2) var cm_tex: texture_2d<f32>;
+@group(0) @binding(3) var mask_tex: texture_2d<u32>;
+@group(0) @binding(4) var wrap_linear: sampler;
+
+fn height_fraction(y: f32) -> f32 {
+    return (y - frame.band.x) / (frame.band.y - frame.band.x);
+}
+
+// The part [t0, t1] of the ray inside the slab bottom <= y <= top (camera
+// below, inside or above alike); t1 <= t0 where the ray misses it.
+fn band_segment(origin: vec3f, dir: vec3f, bottom: f32, top: f32, max_t: f32) -> vec2f {
+    if abs(dir.y) < 1e-8 {
+        if origin.y < bottom || origin.y > top {
+            return vec2f(0.0, -1.0);
+        }
+        return vec2f(0.0, max_t);
+    }
+    let ta = (bottom - origin.y) / dir.y;
+    let tb = (top - origin.y) / dir.y;
+    return vec2f(max(min(ta, tb), 0.0), min(max(ta, tb), max_t));
+}
+
+fn hash3(x: i32, y: i32, z: i32) -> f32 {
+    var h = (bitcast<u32>(x) * 0x8da6b343u) ^ (bitcast<u32>(y) * 0xd8163841u)
+        ^ (bitcast<u32>(z) * 0xcb1ab31fu);
+    h ^= h >> 13u;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15u;
+    return f32(h & 0x00ffffffu) / 16777216.0;
+}
+
+fn wrap_i(a: i32, period: i32) -> i32 {
+    return ((a % period) + period) % period;
+}
+
+fn value_noise3(q: vec3f, period: i32) -> f32 {
+    let f = floor(q);
+    let t = q - f;
+    let w = t * t * (vec3f(3.0) - 2.0 * t);
+    let x = i32(f.x);
+    let y = i32(f.y);
+    let z = i32(f.z);
+    let x0 = wrap_i(x, period);
+    let x1 = wrap_i(x + 1, period);
+    let y0 = wrap_i(y, period);
+    let y1 = wrap_i(y + 1, period);
+    let z0 = wrap_i(z, period);
+    let z1 = wrap_i(z + 1, period);
+    let x00 = mix(hash3(x0, y0, z0), hash3(x1, y0, z0), w.x);
+    let x10 = mix(hash3(x0, y1, z0), hash3(x1, y1, z0), w.x);
+    let x01 = mix(hash3(x0, y0, z1), hash3(x1, y0, z1), w.x);
+    let x11 = mix(hash3(x0, y1, z1), hash3(x1, y1, z1), w.x);
+    return mix(mix(x00, x10, w.y), mix(x01, x11, w.y), w.z);
+}
+
+fn detail_noise(p: vec3f, scale_m: f32) -> f32 {
+    let q = p / scale_m;
+    return 0.65 * value_noise3(q, 64) + 0.35 * value_noise3(q * 2.0 + vec3f(17.3), 128);
+}
+
+// True where the coarse max-coverage mask says no P texel near `(x, z)`
+// has coverage: the density there is zero whatever the detail warp does,
+// so the noise and the texture reads are skipped.
+fn coarse_empty(x: f32, z: f32) -> bool {
+    let u = x / frame.map.x;
+    let v = z / frame.map.x;
+    let pw = f32(frame.counts.y);
+    let ph = f32(frame.counts.z);
+    let cell = f32(frame.mask.z);
+    let mx = i32(floor((u - floor(u)) * pw / cell));
+    let my = i32(floor((v - floor(v)) * ph / cell));
+    let c = vec2i(clamp(mx, 0, i32(frame.mask.x) - 1), clamp(my, 0, i32(frame.mask.y) - 1));
+    return textureLoad(mask_tex, c, 0).r == 0u;
+}
+
+// (shape, local top, fill) of the cloud footprint at map coordinate uv.
+fn footprint(u: f32, v: f32) -> vec3f {
+    let pf = textureSampleLevel(p_tex, wrap_linear, vec2f(u, v), 0.0);
+    if pf.r <= 1e-3 {
+        return vec3f(0.0);
+    }
+    let cm = textureSampleLevel(cm_tex, wrap_linear, vec2f(u, v), 0.0);
+    let cov = clamp(frame.band.z * pf.r, 0.0, 1.0);
+    let shape = clamp((cm.r - (1.0 - cov)) / max(cov, 1e-3), 0.0, 1.0);
+    if shape <= 0.0 {
+        return vec3f(0.0);
+    }
+    let top = clamp(0.15 + 0.85 * pf.g, 0.0, 1.0) * sqrt(shape) * (0.75 + 0.25 * cm.g);
+    return vec3f(shape, top, pf.b);
+}
+
+// Extinction sigma_t (1/m) at p; `detail` false leaves out the detail noise
+// (shadow rays).
+fn density_at(p: vec3f, detail: bool) -> f32 {
+    let eta = height_fraction(p.y);
+    if eta < 0.0 || eta > 1.0 {
+        return 0.0;
+    }
+    if coarse_empty(p.x, p.z) {
+        return 0.0;
+    }
+    let strength = frame.map.y;
+    let scale = frame.map.z;
+    var x = p.x;
+    var z = p.z;
+    var n = 0.0;
+    let with_detail = DETAIL && detail;
+    if with_detail {
+        n = detail_noise(p, scale);
+        let warp = scale * strength;
+        x += (n - 0.5) * 2.0 * warp;
+        z += (value_noise3(p / scale + vec3f(31.1), 64) - 0.5) * 2.0 * warp;
+    }
+    let fp = footprint(x / frame.map.x, z / frame.map.x);
+    var top = fp.y;
+    if with_detail {
+        top *= 1.0 - 0.3 * strength * n;
+    }
+    if fp.x <= 0.0 || eta >= top {
+        return 0.0;
+    }
+    let base = smoothstep(0.0, BASE_RAMP, eta);
+    let t = eta / top;
+    let dome = clamp((1.0 - t * t) * 3.0, 0.0, 1.0);
+    var profile = base * dome * min(fp.x * 4.0, 1.0);
+    if with_detail {
+        profile = max(profile - strength * n * (1.0 - profile), 0.0);
+    }
+    return frame.band.w * (0.3 + 0.7 * fp.z) * profile;
+}
+
+fn phase_hg(cos_theta: f32, g: f32) -> f32 {
+    let g2 = g * g;
+    return (1.0 - g2) / (4.0 * PI * pow(max(1.0 + g2 - 2.0 * g * cos_theta, 1e-6), 1.5));
+}
+
+fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
+    return 0.75 * phase_hg(cos_theta, 0.8 * eccentricity)
+        + 0.25 * phase_hg(cos_theta, -0.3 * eccentricity);
+}
+
+fn sun_optical_depth(p: vec3f, sun_dir: vec3f) -> f32 {
+    if SHADOW_STEPS == 0u {
+        return 0.0;
+    }
+    var to_top = 2000.0;
+    if sun_dir.y > 1e-3 {
+        to_top = max(frame.band.y - p.y, 0.0) / sun_dir.y;
+    }
+    let length = min(to_top, 2000.0);
+    let parts = f32(SHADOW_STEPS * (SHADOW_STEPS + 1u) / 2u);
+    var t = 0.0;
+    var tau = 0.0;
+    for (var i = 0u; i < SHADOW_STEPS; i++) {
+        let dt = length * f32(i + 1u) / parts;
+        let q = p + sun_dir * (t + 0.5 * dt);
+        if height_fraction(q.y) > 1.0 {
+            break;
+        }
+        tau += density_at(q, false) * dt;
+        t += dt;
+    }
+    return tau;
+}
+
+fn sun_transmittance(p: vec3f, sun_dir: vec3f) -> f32 {
+    return exp(-sun_optical_depth(p, sun_dir));
+}
+
+fn sun_scattering(tau_sun: f32, cos_theta: f32) -> f32 {
+    var sum = 0.0;
+    var a = 1.0;
+    for (var i = 0u; i <= OCTAVES; i++) {
+        sum += a * phase_dual(cos_theta, a) * exp(-a * tau_sun);
+        a *= 0.5;
+    }
+    return sum;
+}
+
+fn integrate_step(s: vec3f, sigma_t: f32, dt: f32) -> vec3f {
+    if sigma_t * dt < 1e-5 {
+        return s * dt;
+    }
+    return (s - s * exp(-sigma_t * dt)) / sigma_t;
+}
+
+fn sun_color(sun_dir: vec3f) -> vec3f {
+    let air_mass = 1.0 / max(sun_dir.y, 0.035);
+    return exp(-vec3f(0.018, 0.04, 0.09) * air_mass);
+}
+
+fn normalize_or(v: vec3f, fallback: vec3f) -> vec3f {
+    let l = length(v);
+    if l > 0.0 && l < 3.4e38 {
+        return v / l;
+    }
+    return fallback;
+}
+
+// The sky above the horizon (dir.y >= 0).
+fn sky_above(dir: vec3f, sun_dir: vec3f) -> vec3f {
+    let sun = sun_color(sun_dir);
+    let day = max(sqrt(clamp(sun_dir.y, 0.0, 1.0)), 0.15);
+    let zenith = vec3f(0.16, 0.32, 0.75);
+    let horizon = vec3f(0.62, 0.72, 0.86);
+    let f = pow(1.0 - dir.y, 4.0);
+    let base = mix(zenith, horizon, f) * day * mix(sun, vec3f(1.0), 0.6);
+    let glow = sun * (phase_hg(dot(dir, sun_dir), 0.76) * 0.35);
+    return base + glow;
+}
+
+fn sky_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
+    if dir.y < 0.0 {
+        let sun = sun_color(sun_dir);
+        let day = max(sqrt(clamp(sun_dir.y, 0.0, 1.0)), 0.15);
+        let ground = vec3f(0.10, 0.12, 0.10) * day * (0.4 + 0.6 * sun);
+        let horizon = sky_above(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
+        let f = exp(-(-dir.y) * 40.0);
+        return mix(ground, horizon, f);
+    }
+    return sky_above(dir, sun_dir);
+}
+
+fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {
+    if dot(dir, sun_dir) > SUN_DISK_COS {
+        return sun_color(sun_dir) * 60.0;
+    }
+    return vec3f(0.0);
+}
+
+fn pixel_dither(x: u32, y: u32) -> f32 {
+    return fract(52.982918 * fract(0.06711056 * f32(x) + 0.00583715 * f32(y)));
+}
+
+fn tone_map(c: f32, exposure: f32) -> f32 {
+    return 1.0 - exp(-max(c, 0.0) * exposure);
+}
+
+// The ray through pixel coordinate `px` (0.5 = a pixel's centre).
+fn camera_ray(px: vec2f) -> vec3f {
+    let tan_half = frame.cam_pos.w;
+    let aspect = frame.cam_forward.w;
+    let sx = (2.0 * px.x / frame.cam_right.w - 1.0) * tan_half * aspect;
+    let sy = (1.0 - 2.0 * px.y / frame.cam_up.w) * tan_half;
+    return normalize(frame.cam_forward.xyz + frame.cam_right.xyz * sx + frame.cam_up.xyz * sy);
+}
+
+// The result of one ray: premultiplied cloud radiance (the light of the
+// clouds plus the haze in front of them) and opacity, the transmittance-
+// weighted cloud distance (for TSAA), and the density samples taken.
+struct CloudSample {
+    premultiplied: vec4f,
+    distance: f32,
+    samples: u32,
+}
+
+// Marches the band segment of one ray up to `max_t` (the twin of
+// `march_ray` less the background, which the composite pass adds).
+fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample {
+    var out: CloudSample;
+    out.premultiplied = vec4f(0.0);
+    out.distance = frame.sun_light.w;
+    out.samples = 0u;
+    let seg = band_segment(origin, dir, frame.band.x, frame.band.y, max_t);
+    if seg.y <= seg.x {
+        return out;
+    }
+    let t0 = seg.x;
+    let t1 = seg.y;
+    let sun_dir = frame.sun_dir.xyz;
+    let steps = max(frame.counts.x, 1u);
+    let dt = (t1 - t0) / f32(steps);
+    let sun = frame.sun_light.xyz;
+    let ambient_top = frame.ambient_top.xyz;
+    let cos_theta = dot(dir, sun_dir);
+    var transmittance = 1.0;
+    var light = vec3f(0.0);
+    var depth_weighted = 0.0;
+    var samples = 1u;
+    var sigma_a = density_at(origin + dir * t0, true);
+    for (var i = 0u; i < steps; i++) {
+        let ta = t0 + f32(i) * dt;
+        let sigma_b = density_at(origin + dir * (ta + dt), true);
+        samples += 1u;
+        let touched = sigma_a > 0.0 || sigma_b > 0.0;
+        sigma_a = sigma_b;
+        var n = 1u;
+        var h = dt;
+        if touched {
+            n = REFINE;
+            h = dt / f32(REFINE);
+        }
+        for (var j = 0u; j < n; j++) {
+            let t = ta + (f32(j) + dither) * h;
+            let p = origin + dir * t;
+            let sigma_t = density_at(p, true);
+            samples += 1u;
+            if sigma_t <= 0.0 {
+                continue;
+            }
+            let tau_sun = sun_optical_depth(p, sun_dir);
+            samples += SHADOW_STEPS;
+            let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
+            let ambient = ambient_top * (0.35 + 0.65 * eta);
+            let scatter = sun * sun_scattering(tau_sun, cos_theta) + ambient;
+            let s = scatter * (sigma_t * ALBEDO);
+            let step_t = exp(-sigma_t * h);
+            light += integrate_step(s, sigma_t, h) * transmittance;
+            depth_weighted += t * transmittance * (1.0 - step_t);
+            transmittance *= step_t;
+            if transmittance < MIN_TRANSMITTANCE {
+                break;
+            }
+        }
+        if transmittance < MIN_TRANSMITTANCE {
+            break;
+        }
+    }
+    let opacity = 1.0 - transmittance;
+    var cloud_distance = 0.0;
+    if opacity > 0.0 {
+        cloud_distance = depth_weighted / opacity;
+        out.distance = cloud_distance;
+    }
+    let haze = exp(-cloud_distance / max(frame.sun_dir.w, 1.0));
+    let horizon = sky_radiance(normalize_or(vec3f(dir.x, max(dir.y, 0.0), dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+    out.premultiplied = vec4f(light * haze + horizon * (opacity * (1.0 - haze)), opacity);
+    out.samples = samples;
+    return out;
+}
+
+// Distance along `dir` to the surface at depth-buffer value `d` (the
+// projection of `Camera::view_projection`: left-handed, depth 0 at `near`,
+// 1 at `far`).
+fn depth_to_distance(d: f32, dir: vec3f) -> f32 {
+    let near = frame.depth.x;
+    let far = frame.depth.y;
+    let z = near * far / (far - d * (far - near));
+    return z / max(dot(dir, frame.cam_forward.xyz), 1e-6);
+}
+
+// The march of one pixel at fragment position `pos` up to `max_t`.
+fn cloud_pixel(pos: vec2f, max_t: f32) -> CloudSample {
+    let px = vec2u(pos);
+    let dir = camera_ray(pos + frame.jitter.xy);
+    let dither = fract(pixel_dither(px.x, px.y) + frame.jitter.z);
+    var s = march_ray(frame.cam_pos.xyz, dir, dither, max_t);
+    if DEBUG_COUNT {
+        s.premultiplied = vec4f(f32(s.samples), 0.0, 0.0, 0.0);
+    }
+    return s;
+}
+
+struct FullScreen {
+    @builtin(position) position: vec4f,
+}
+
+@vertex
+fn vs_full_screen(@builtin(vertex_index) i: u32) -> FullScreen {
+    // One triangle that covers the screen.
+    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
+    var out: FullScreen;
+    out.position = vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+    return out;
+}

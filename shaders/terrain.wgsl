@@ -1,0 +1,109 @@
+// The terrain pass (appended to clouds.wgsl), built only when the scene has
+// terrain: the heightfield rasterised as a grid mesh, tiled around the
+// camera to the longest ray, into an HDR colour target and a depth buffer.
+// It is lit by the sun through the clouds (their shadow) and the sky, and
+// faded by aerial perspective: the twins of `height_at`, `normal_at`,
+// `terrain_radiance` and `cloud_shadow` in src/render/.
+
+@group(1) @binding(0) var height_tex: texture_2d<f32>;
+
+// Bilinear, periodic height at world (x, z), m (`Heightfield::height_at`).
+fn height_at(x: f32, z: f32) -> f32 {
+    let n = i32(textureDimensions(height_tex).x);
+    let extent = frame.depth.z;
+    let fx = x / extent * f32(n);
+    let fz = z / extent * f32(n);
+    let x0 = floor(fx);
+    let z0 = floor(fz);
+    let tx = fx - x0;
+    let tz = fz - z0;
+    let xa = wrap_i(i32(x0), n);
+    let xb = wrap_i(i32(x0) + 1, n);
+    let za = wrap_i(i32(z0), n);
+    let zb = wrap_i(i32(z0) + 1, n);
+    let h00 = textureLoad(height_tex, vec2i(xa, za), 0).r;
+    let h10 = textureLoad(height_tex, vec2i(xb, za), 0).r;
+    let h01 = textureLoad(height_tex, vec2i(xa, zb), 0).r;
+    let h11 = textureLoad(height_tex, vec2i(xb, zb), 0).r;
+    let top = h00 + (h10 - h00) * tx;
+    let bottom = h01 + (h11 - h01) * tx;
+    return top + (bottom - top) * tz;
+}
+
+fn normal_at(x: f32, z: f32) -> vec3f {
+    let e = frame.depth.z / f32(textureDimensions(height_tex).x);
+    let dx = height_at(x + e, z) - height_at(x - e, z);
+    let dz = height_at(x, z + e) - height_at(x, z - e);
+    return normalize(vec3f(-dx, 2.0 * e, -dz));
+}
+
+fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
+    let seg = band_segment(p, sun_dir, frame.band.x, frame.band.y, 20000.0);
+    if seg.y <= seg.x {
+        return 1.0;
+    }
+    let n = max(steps, 1u);
+    let dt = (seg.y - seg.x) / f32(n);
+    var tau = 0.0;
+    for (var i = 0u; i < n; i++) {
+        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), false) * dt;
+    }
+    return exp(-tau);
+}
+
+fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
+    let n = normal_at(p.x, p.z);
+    let slope = 1.0 - n.y;
+    let albedo = mix(vec3f(0.07, 0.11, 0.04), vec3f(0.16, 0.13, 0.09), min(slope * 3.0, 1.0));
+    var shadow = 1.0;
+    if SHADOW_STEPS > 0u && sun_dir.y > 0.0 {
+        shadow = cloud_shadow(p, sun_dir, SHADOW_STEPS * 2u);
+    }
+    let sun = frame.sun_light.xyz;
+    let sky = frame.sky_up.xyz;
+    let lit = albedo * (sun * (max(dot(n, sun_dir), 0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
+    let haze = exp(-t / max(frame.sun_dir.w, 1.0));
+    let horizon = sky_radiance(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
+    return lit * haze + horizon * (1.0 - haze);
+}
+
+struct TerrainVertex {
+    @builtin(position) clip: vec4f,
+    @location(0) world: vec3f,
+}
+
+@vertex
+fn vs_terrain(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> TerrainVertex {
+    let n = textureDimensions(height_tex).x;
+    let extent = frame.depth.z;
+    let quad = vi / 6u;
+    let corner = vi % 6u;
+    var d = vec2u(0u, 0u);
+    if corner == 1u || corner == 4u {
+        d = vec2u(1u, 0u);
+    } else if corner == 2u || corner == 3u {
+        d = vec2u(0u, 1u);
+    } else if corner == 5u {
+        d = vec2u(1u, 1u);
+    }
+    let g = vec2u(quad % n, quad / n) + d;
+    // Tiles around the camera's tile, enough to reach the longest ray.
+    let reach = i32(ceil(frame.sun_light.w / extent));
+    let side = 2 * reach + 1;
+    let tile = vec2i(i32(ii) % side - reach, i32(ii) / side - reach)
+        + vec2i(floor(frame.cam_pos.xz / extent));
+    let xz = (vec2f(tile) + vec2f(g) / f32(n)) * extent;
+    let y = textureLoad(height_tex, vec2i(g % n), 0).r;
+    var out: TerrainVertex;
+    out.world = vec3f(xz.x, y, xz.y);
+    out.clip = frame.view_proj * vec4f(out.world, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_terrain(in: TerrainVertex) -> @location(0) vec4f {
+    let to = in.world - frame.cam_pos.xyz;
+    let t = length(to);
+    let dir = to / max(t, 1e-3);
+    return vec4f(terrain_radiance(in.world, t, dir, frame.sun_dir.xyz), 1.0);
+}

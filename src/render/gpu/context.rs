@@ -1,0 +1,173 @@
+//! A headless wgpu device for offscreen rendering, tests and benchmarks:
+//! adapter selection, validation errors returned (not panics), readback.
+
+use std::sync::mpsc;
+
+/// Errors of the headless GPU path.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error(
+        "no GPU adapter found. Install a Vulkan driver (on Debian/Ubuntu, software Vulkan: `apt-get install mesa-vulkan-drivers`), or render with --backend cpu"
+    )]
+    NoAdapter,
+    #[error("the GPU adapter {adapter} refused a device: {message}")]
+    RequestDevice { adapter: String, message: String },
+    #[error("wgpu reported an error: {0}")]
+    Wgpu(String),
+    #[error("reading the image back from the GPU failed: {0}")]
+    Readback(String),
+    #[error(transparent)]
+    Render(#[from] super::RenderError),
+}
+
+/// A device and queue with what the renderer can use.
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter_info: wgpu::AdapterInfo,
+    /// Whether the device records timestamp queries.
+    pub timestamps: bool,
+}
+
+impl GpuContext {
+    /// The first adapter wgpu offers (high performance preferred), with
+    /// timestamp queries when it has them. `Err(NoAdapter)` when there is
+    /// none.
+    pub fn new() -> Result<Self, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|_| GpuError::NoAdapter)?;
+        Self::from_adapter(&adapter)
+    }
+
+    /// A device on `adapter`.
+    pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Self, GpuError> {
+        let adapter_info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("cumulus"),
+            required_features,
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::RequestDevice {
+            adapter: adapter_info.name.clone(),
+            message: e.to_string(),
+        })?;
+        Ok(Self {
+            device,
+            queue,
+            adapter_info,
+            timestamps,
+        })
+    }
+
+    /// "name (backend, driver)".
+    pub fn describe(&self) -> String {
+        let i = &self.adapter_info;
+        format!(
+            "{} ({:?}, {} {})",
+            i.name, i.backend, i.driver, i.driver_info
+        )
+    }
+
+    /// Runs `f` inside validation and out-of-memory error scopes and waits
+    /// for the GPU: an error wgpu reports comes back as `Err`, not a panic.
+    pub fn checked<T>(&self, f: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let out = f();
+        let v = pollster::block_on(validation.pop());
+        let o = pollster::block_on(oom.pop());
+        match v.or(o) {
+            Some(e) => Err(GpuError::Wgpu(e.to_string())),
+            None => Ok(out),
+        }
+    }
+
+    /// Blocks until the GPU is idle.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Wgpu(e.to_string()))
+    }
+
+    /// Copies `texture` (`bytes_per_texel` per texel, one mip) to the CPU:
+    /// tightly packed rows.
+    pub fn read_texture(
+        &self,
+        texture: &wgpu::Texture,
+        bytes_per_texel: u32,
+    ) -> Result<Vec<u8>, GpuError> {
+        let size = texture.size();
+        let row = size.width * bytes_per_texel;
+        let padded =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: padded as u64 * size.height as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback"),
+            });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(size.height),
+                },
+            },
+            size,
+        );
+        self.queue.submit([encoder.finish()]);
+        let slice = buffer.slice(..);
+        let (tx, rx) = mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv()
+            .map_err(|e| GpuError::Readback(e.to_string()))?
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let mut out = Vec::with_capacity((row * size.height) as usize);
+        for y in 0..size.height as usize {
+            let start = y * padded as usize;
+            out.extend_from_slice(&data[start..start + row as usize]);
+        }
+        drop(data);
+        buffer.unmap();
+        Ok(out)
+    }
+
+    /// Reads an `Rgba16Float` texture as `f32` RGBA.
+    pub fn read_rgba16f(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, GpuError> {
+        let bytes = self.read_texture(texture, 8)?;
+        let halves: &[half::f16] = bytemuck::cast_slice(&bytes);
+        Ok(halves
+            .chunks_exact(4)
+            .map(|c| [c[0].to_f32(), c[1].to_f32(), c[2].to_f32(), c[3].to_f32()])
+            .collect())
+    }
+}

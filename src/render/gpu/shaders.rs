@@ -1,0 +1,120 @@
+//! WGSL sources, assembled per variant. `shaders/clouds.wgsl` holds the
+//! shared functions (the twins of `render::cpu`); each pass appends its own
+//! file, and the variant's bindings and entry point are appended here, so a
+//! feature a scene does not use has no binding, no output and no code.
+
+/// The shared functions and the frame uniform block.
+pub const CLOUDS: &str = include_str!("../../../shaders/clouds.wgsl");
+/// The composite pass.
+pub const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
+/// The TSAA resolve pass.
+pub const TSAA: &str = include_str!("../../../shaders/tsaa.wgsl");
+/// The terrain pass.
+pub const TERRAIN: &str = include_str!("../../../shaders/terrain.wgsl");
+
+/// The cloud pass's source: marches to the depth buffer's surface when
+/// `depth`, and writes the cloud distance for the TSAA reprojection when
+/// `tsaa`.
+pub fn cloud_pass(depth: bool, tsaa: bool) -> String {
+    let mut s = String::from(CLOUDS);
+    if depth {
+        s.push_str("\n@group(1) @binding(0) var depth_tex: texture_depth_2d;\n");
+    }
+    if tsaa {
+        s.push_str(
+            "\nstruct CloudOut {\n    @location(0) cloud: vec4f,\n    @location(1) distance: f32,\n}\n",
+        );
+    }
+    let out = if tsaa {
+        "CloudOut"
+    } else {
+        "@location(0) vec4f"
+    };
+    s.push_str(&format!(
+        "\n@fragment\nfn fs_clouds(@builtin(position) pos: vec4f) -> {out} {{\n    var max_t = frame.sun_light.w;\n"
+    ));
+    if depth {
+        s.push_str(
+            "    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if d < 1.0 {\n        max_t = min(max_t, depth_to_distance(d, camera_ray(pos.xy)));\n    }\n",
+        );
+    }
+    s.push_str("    let c = cloud_pixel(pos.xy, max_t);\n");
+    if tsaa {
+        s.push_str("    return CloudOut(c.premultiplied, c.distance);\n}\n");
+    } else {
+        s.push_str("    return c.premultiplied;\n}\n");
+    }
+    s
+}
+
+/// What lies behind the clouds in the composite pass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Background {
+    /// The analytic sky and sun disk everywhere.
+    Sky,
+    /// The terrain pass's HDR colour where it drew (alpha 1), sky elsewhere.
+    Terrain,
+    /// An external depth buffer: sky where the depth is at the far plane;
+    /// elsewhere the clouds are blended over the target's colour.
+    ExternalDepth,
+}
+
+/// The composite pass's source for `background`.
+pub fn composite_pass(background: Background) -> String {
+    let mut s = format!("{CLOUDS}\n{COMPOSITE}\n");
+    match background {
+        Background::Sky => s.push_str(
+            "@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);\n}\n",
+        ),
+        Background::Terrain => s.push_str(
+            "@group(1) @binding(1) var background_tex: texture_2d<f32>;\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let b = textureLoad(background_tex, vec2i(pos.xy), 0);\n    var bg = sky_background(pos.xy);\n    if b.a > 0.5 {\n        bg = b.rgb;\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * bg), 1.0);\n}\n",
+        ),
+        Background::ExternalDepth => s.push_str(
+            "@group(1) @binding(1) var depth_tex: texture_depth_2d;\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if d < 1.0 {\n        return vec4f(display(c.rgb), c.a);\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);\n}\n",
+        ),
+    }
+    s
+}
+
+/// The TSAA pass's source.
+pub fn tsaa_pass() -> String {
+    format!("{CLOUDS}\n{TSAA}")
+}
+
+/// The terrain pass's source.
+pub fn terrain_pass() -> String {
+    format!("{CLOUDS}\n{TERRAIN}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every variant parses and validates with naga (no GPU needed).
+    #[test]
+    fn every_variant_validates() {
+        let mut sources = vec![tsaa_pass(), terrain_pass()];
+        for depth in [false, true] {
+            for tsaa in [false, true] {
+                sources.push(cloud_pass(depth, tsaa));
+            }
+        }
+        for b in [
+            Background::Sky,
+            Background::Terrain,
+            Background::ExternalDepth,
+        ] {
+            sources.push(composite_pass(b));
+        }
+        for src in sources {
+            let module = naga::front::wgsl::parse_str(&src)
+                .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::empty(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+        }
+    }
+}
