@@ -107,9 +107,20 @@ struct RenderArgs {
     /// Primary ray-march steps (overrides render.steps).
     #[arg(long)]
     steps: Option<u32>,
-    /// auto: the GPU when one is usable, else the CPU reference; cpu; gpu.
+    /// auto: a hardware GPU when wgpu finds one, else the CPU reference;
+    /// cpu; gpu (any adapter wgpu finds, software Vulkan included).
+    /// WGPU_BACKEND (vulkan, gl, metal, dx12) narrows the search.
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     backend: Backend,
+    /// GPU frames rendered from the still camera before the picture is
+    /// taken, so TSAA has converged (default: 32 with render.tsaa, else 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    frames: Option<u32>,
+    /// GPU: also time this many frames (after 10 warm-up frames) and print
+    /// the median and 95th percentile, from timestamp queries when the
+    /// adapter has them, else CPU wall time (labelled).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    time_frames: Option<u32>,
 }
 
 /// Which renderer draws the image.
@@ -390,6 +401,77 @@ fn convergence_cmd(a: ConvergenceArgs) -> Result<()> {
     Ok(())
 }
 
+/// The GPU, from `WGPU_BACKEND` when set (the binary's edge reads the
+/// environment, the library does not).
+fn gpu_context() -> Result<cumulus::render::gpu::GpuContext, cumulus::render::gpu::GpuError> {
+    let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+    cumulus::render::gpu::GpuContext::new(backends)
+}
+
+/// `render` on the GPU: `--frames` frames (TSAA converges), the last one
+/// saved; `--time-frames` times more.
+fn render_gpu(
+    ctx: &cumulus::render::gpu::GpuContext,
+    a: &RenderArgs,
+    scene: &cumulus::scene::Scene,
+    prepared: &cumulus::render::prepare::Prepared,
+) -> Result<()> {
+    use cumulus::render::gpu::Headless;
+    let r = &scene.render;
+    eprintln!("backend: gpu ({})", ctx.describe());
+    let settings = prepared.gpu_settings(r, r.quality());
+    let mut hl = Headless::new(ctx, prepared, &settings, r.width, r.height)?;
+    let frames = a.frames.unwrap_or(if r.tsaa { 32 } else { 1 });
+    let start = std::time::Instant::now();
+    hl.render(ctx, &r.camera(), frames)?;
+    let elapsed = start.elapsed();
+    if let Some(out) = &a.out {
+        let bytes = hl.read_rgb8(ctx)?;
+        let img =
+            image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
+        write_png_atomically(out, &img)
+            .with_context(|| format!("{}: cannot write image", out.display()))?;
+        eprintln!(
+            "rendered {}x{}, {frames} frame(s) in {:.2} s ({} steps, {} shadow steps, {} octaves, TSAA {}; passes {}); wrote {}",
+            r.width,
+            r.height,
+            elapsed.as_secs_f64(),
+            r.steps,
+            r.shadow_steps,
+            r.octaves,
+            if r.tsaa { "on" } else { "off" },
+            hl.renderer.last_passes().join(", "),
+            out.display()
+        );
+    }
+    if let Some(n) = a.time_frames {
+        let t = hl.time_frames(ctx, &r.camera(), 10, n)?;
+        let source = if t.gpu {
+            "GPU timestamps"
+        } else {
+            "CPU wall time, submit to idle (no timestamp queries)"
+        };
+        println!(
+            "frame {}x{}: median {:.3} ms, p95 {:.3} ms over {n} frames ({source}; {})",
+            r.width,
+            r.height,
+            t.median(),
+            t.p95(),
+            ctx.describe()
+        );
+        if t.gpu {
+            for (k, pass) in t.passes.iter().enumerate() {
+                let v: Vec<f64> = t.per_pass.iter().map(|f| f[k]).collect();
+                println!(
+                    "  {pass}: median {:.3} ms",
+                    cumulus::render::gpu::headless::FrameTimes::quantile(&v, 0.5)
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 fn render_cmd(a: RenderArgs) -> Result<()> {
     use cumulus::render::cpu::renderer::{render_linear, to_srgb8};
     use cumulus::render::prepare::Prepared;
@@ -411,10 +493,27 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
     scene
         .validate()
         .context("after applying --width/--height/--time-s/--steps")?;
-    if a.backend == Backend::Gpu {
-        bail!("--backend gpu: the wgpu renderer is not built yet; use --backend cpu (or auto)");
+    let gpu = match a.backend {
+        Backend::Cpu => None,
+        Backend::Gpu => Some(gpu_context().context("--backend gpu")?),
+        Backend::Auto => match gpu_context() {
+            Ok(c) if c.adapter_info.device_type != wgpu::DeviceType::Cpu => Some(c),
+            Ok(c) => {
+                eprintln!(
+                    "backend: cpu (the only GPU adapter is software, {}; --backend gpu uses it)",
+                    c.adapter_info.name
+                );
+                None
+            }
+            Err(e) => {
+                eprintln!("backend: cpu ({e})");
+                None
+            }
+        },
+    };
+    if gpu.is_none() && a.time_frames.is_some() {
+        bail!("--time-frames needs the GPU backend (--backend gpu)");
     }
-    eprintln!("backend: cpu (the CPU reference renderer; no GPU backend is built yet)");
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
@@ -459,6 +558,10 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
             dir.display()
         );
     }
+    if let Some(ctx) = &gpu {
+        return render_gpu(ctx, &a, &scene, &prepared);
+    }
+    eprintln!("backend: cpu (the CPU reference renderer)");
     let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
     let linear = render_linear(r.width, r.height, &frame);

@@ -94,6 +94,17 @@ impl ProjectedField {
         )
     }
 
+    /// A field from `width x height` texels (row-major); `None` when the
+    /// count does not match.
+    pub fn from_texels(width: usize, height: usize, texels: Vec<[f32; 3]>) -> Option<Self> {
+        if texels.len() != width * height {
+            return None;
+        }
+        let mut f = Self::new(width, height);
+        f.texels = texels;
+        Some(f)
+    }
+
     /// A field filled with one texel value (for tests and tools).
     pub fn uniform(width: usize, height: usize, texel: [f32; 3]) -> Self {
         let mut f = Self::new(width, height);

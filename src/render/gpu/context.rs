@@ -30,12 +30,14 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// The first adapter wgpu offers (high performance preferred), with
-    /// timestamp queries when it has them. `Err(NoAdapter)` when there is
-    /// none.
-    pub fn new() -> Result<Self, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    /// The first adapter of `backends` that wgpu offers (high performance
+    /// preferred), with timestamp queries when it has them.
+    /// `Err(NoAdapter)` when there is none. (The binaries pass
+    /// `wgpu::Backends::from_env()`, i.e. `WGPU_BACKEND`, when it is set.)
+    pub fn new(backends: wgpu::Backends) -> Result<Self, GpuError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,

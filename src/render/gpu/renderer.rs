@@ -676,6 +676,17 @@ impl CloudRenderer {
         }
     }
 
+    /// The frame counter that picks the TSAA jitter (it cycles every
+    /// [`super::tsaa::JITTER_CYCLE`] frames).
+    pub fn frame_index(&self) -> u32 {
+        self.frame_index
+    }
+
+    /// Sets the frame counter (to replay a jitter phase).
+    pub fn set_frame_index(&mut self, n: u32) {
+        self.frame_index = n;
+    }
+
     /// Frames in the TSAA history since the last reset (0 without TSAA).
     pub fn history_frames(&self) -> u32 {
         self.tsaa.as_ref().map_or(0, |t| t.frames)
