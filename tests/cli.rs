@@ -318,6 +318,8 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
             "96",
             "--height",
             "72",
+            "--backend",
+            "cpu",
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(
@@ -350,18 +352,46 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
         "cloud pixels: {all_cloud} (upper third: {cloud})"
     );
 
+    // No adapter (WGPU_BACKEND names a backend this platform lacks): gpu
+    // is a clear error that says how to get one; auto falls back to the CPU
+    // and says why.
     let out = dir.path().join("gpu.png");
-    let o = cumulus(&[
+    let args = [
         "render",
         "--scene",
         scene.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-        "--backend",
-        "gpu",
-    ]);
+        "--width",
+        "32",
+        "--height",
+        "24",
+    ];
+    let no_adapter = |backend: &str| {
+        let mut a = args.to_vec();
+        a.extend(["--backend", backend]);
+        Command::new(env!("CARGO_BIN_EXE_cumulus"))
+            .args(&a)
+            .env("WGPU_BACKEND", if cfg!(windows) { "metal" } else { "dx12" })
+            .output()
+            .expect("binary runs")
+    };
+    let o = no_adapter("gpu");
     assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("--backend gpu"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no GPU adapter") && stderr(&o).contains("--backend cpu"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = no_adapter("auto");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("backend: cpu (no GPU adapter"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_file(&out).unwrap();
     assert!(!out.exists());
     let o = cumulus(&[
         "render",
@@ -375,4 +405,42 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("render.steps"), "{}", stderr(&o));
     assert!(!out.exists());
+}
+
+#[test]
+fn render_on_the_gpu_writes_the_png_and_times_frames() {
+    if cumulus::render::gpu::GpuContext::new(wgpu::Backends::all()).is_err() {
+        assert!(
+            std::env::var("CUMULUS_REQUIRE_GPU").ok().as_deref() != Some("1"),
+            "CUMULUS_REQUIRE_GPU=1 but no GPU adapter was found"
+        );
+        eprintln!("SKIPPED: no GPU adapter");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("gpu.png");
+    let scene = root().join("scenes/fair_weather.toml");
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "--backend",
+        "gpu",
+        "--frames",
+        "3",
+        "--time-frames",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("backend: gpu"), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("frame 40x30: median"), "{stdout}");
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (40, 30));
 }

@@ -78,3 +78,63 @@ impl CoverageMask {
         self.cells[my * self.width + mx] == 0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::cloud_map::{CloudMap, CloudMapConfig};
+    use crate::render::cpu::density::{DensityParams, Fields, density_at, hash3};
+    use glam::Vec3;
+
+    /// Wherever the mask is clear, the CPU density is zero: the GPU's early
+    /// exit changes no pixel. Checked over a patchy P with the detail warp
+    /// on, at many points of the band (fails without the dilation).
+    #[test]
+    fn a_clear_cell_has_no_density_with_the_detail_warp() {
+        let (w, h) = (96, 80);
+        let texels = (0..w * h)
+            .map(|k| {
+                let (x, y) = ((k % w) as i64, (k / w) as i64);
+                // A few blobs and a line along the wrap edge.
+                let blob = (x - 30).pow(2) + (y - 20).pow(2) < 36
+                    || (x - 70).pow(2) + (y - 60).pow(2) < 9
+                    || x == w as i64 - 1;
+                if blob { [1.0, 0.8, 0.7] } else { [0.0; 3] }
+            })
+            .collect();
+        let p = ProjectedField::from_texels(w, h, texels).expect("size");
+        let cm = CloudMap::generate(&CloudMapConfig {
+            size: 64,
+            ..Default::default()
+        });
+        let d = DensityParams {
+            band_bottom_m: 600.0,
+            band_top_m: 1600.0,
+            coverage: 1.0,
+            extinction_per_m: 0.04,
+            map_extent_m: 10_000.0,
+            detail_strength: 0.8,
+            detail_scale_m: 400.0,
+        };
+        let mask = CoverageMask::build(&p, d.map_extent_m, d.detail_scale_m * d.detail_strength);
+        let f = Fields {
+            p: &p,
+            cloud_map: &cm,
+        };
+        let (mut clear, mut dense) = (0, 0);
+        for i in 0..40_000 {
+            let r = |k: i32| hash3(i, k, 7);
+            let q = Vec3::new(r(1) * 10_000.0, 600.0 + r(2) * 1000.0, r(3) * 10_000.0);
+            let sigma = density_at(q, &f, &d);
+            dense += (sigma > 0.0) as u32;
+            if mask.is_empty_at(q.x / d.map_extent_m, q.z / d.map_extent_m, w, h) {
+                clear += 1;
+                assert_eq!(sigma, 0.0, "density {sigma} in a clear cell at {q}");
+            }
+        }
+        assert!(
+            clear > 20_000 && dense > 100,
+            "clear {clear}, dense {dense}"
+        );
+    }
+}
