@@ -13,11 +13,15 @@ use cumulus::render::cpu::camera::Camera;
 use cumulus::render::cpu::density::DensityParams;
 use cumulus::render::cpu::renderer::RenderSettings;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings, TsaaSettings};
-use cumulus::sim::{Atmosphere, Band, ParametricProfile, PhysicsConfig, ProjectedField, Simulation};
+use cumulus::sim::{
+    Atmosphere, Band, ParametricProfile, PhysicsConfig, ProjectedField, Simulation,
+};
 use glam::{DVec2, Vec3};
 
 fn main() -> Result<()> {
-    let out = std::env::args().nth(1).unwrap_or_else(|| "embed.png".into());
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "embed.png".into());
     // The application's device (any wgpu device works; this one is headless).
     let ctx = GpuContext::new(wgpu::Backends::all()).context("a GPU adapter")?;
     let (device, queue) = (&ctx.device, &ctx.queue);
@@ -46,7 +50,10 @@ fn main() -> Result<()> {
     };
     let extent = physics.domain_size_m;
     let cloud_map = CloudMap::generate(&CloudMapConfig::default());
-    let mut sim = Simulation::new(physics, Atmosphere::from_parametric(&ParametricProfile::FAIR_WEATHER));
+    let mut sim = Simulation::new(
+        physics,
+        Atmosphere::from_parametric(&ParametricProfile::FAIR_WEATHER),
+    );
     sim.set_spawn_sites(
         cloud_map
             .cell_centres(64)
@@ -104,9 +111,16 @@ fn main() -> Result<()> {
         queue.submit([encoder.finish()]);
     }
     let rgba = ctx.read_texture(&target, 4)?;
-    let rgb: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+    let rgb: Vec<u8> = rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
     let img = image::RgbImage::from_raw(width, height, rgb).context("image size")?;
     cumulus::io::write_png_atomically(std::path::Path::new(&out), &img)?;
-    println!("wrote {out} ({}; passes {})", ctx.describe(), clouds.last_passes().join(", "));
+    println!(
+        "wrote {out} ({}; passes {})",
+        ctx.describe(),
+        clouds.last_passes().join(", ")
+    );
     Ok(())
 }

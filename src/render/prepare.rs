@@ -7,11 +7,13 @@ use crate::render::cpu::renderer::{Frame, Quality, RenderSettings};
 use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::Heightfield;
 use crate::scene::{Scene, SceneError};
-use crate::sim::{Band, ProjectedField, Simulation};
+use crate::sim::{Band, Parcels, ProjectedField, Simulation};
 
 /// A scene's textures at one moment.
 pub struct Prepared {
     pub field: ProjectedField,
+    /// The parcels P was projected from (for the per-parcel baseline).
+    pub parcels: Parcels,
     pub cloud_map: CloudMap,
     pub terrain: Option<Heightfield>,
     pub band: Band,
@@ -48,6 +50,7 @@ impl Prepared {
             scene.physics.fill_full_condensed_fraction,
         );
         Ok(Self {
+            parcels: sim.parcels().clone(),
             field,
             cloud_map,
             terrain,

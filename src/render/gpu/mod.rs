@@ -10,6 +10,7 @@ pub mod uniforms;
 
 pub use renderer::{CloudRenderer, GpuSettings, RenderError};
 pub use tsaa::TsaaSettings;
+pub mod baseline;
 pub mod context;
 pub mod headless;
 

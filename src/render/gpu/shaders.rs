@@ -148,7 +148,14 @@ mod tests {
     /// Every variant parses and validates with naga (no GPU needed).
     #[test]
     fn every_variant_validates() {
-        let mut sources = vec![tsaa_pass(), terrain_pass()];
+        let mut sources = vec![
+            tsaa_pass(),
+            terrain_pass(),
+            format!(
+                "{CLOUDS}\n{COMPOSITE}\n{}",
+                super::super::baseline::BASELINE
+            ),
+        ];
         for depth in [false, true] {
             for tsaa in [false, true] {
                 sources.push(cloud_pass(depth, tsaa));
