@@ -123,3 +123,75 @@ pub fn loglog_png(
         source,
     })
 }
+
+/// A bar chart of named values (linear axis from zero).
+pub fn bars_png(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    bars: &[(String, f64)],
+) -> Result<(), ReportError> {
+    REGISTER.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+    let (w, h) = (900u32, 600u32);
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    let top = bars
+        .iter()
+        .map(|b| b.1)
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max)
+        .max(1e-9)
+        * 1.15;
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let n = bars.len().max(1);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((0..n).into_segmented(), 0.0..top)
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .y_desc(y_label)
+            .x_label_formatter(&|v| match v {
+                SegmentValue::CenterOf(i) => bars.get(*i).map_or(String::new(), |b| b.0.clone()),
+                _ => String::new(),
+            })
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| err(&e))?;
+        chart
+            .draw_series(
+                bars.iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.1.is_finite())
+                    .map(|(i, b)| {
+                        let mut r = Rectangle::new(
+                            [
+                                (SegmentValue::Exact(i), 0.0),
+                                (SegmentValue::Exact(i + 1), b.1),
+                            ],
+                            Palette99::pick(0).filled(),
+                        );
+                        r.set_margin(0, 0, 12, 12);
+                        r
+                    }),
+            )
+            .map_err(|e| err(&e))?;
+        root.present().map_err(|e| err(&e))?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| err(&"buffer size"))?;
+    write_png_atomically(path, &img).map_err(|source| ReportError::Write {
+        path: path.to_owned(),
+        source,
+    })
+}

@@ -5,6 +5,7 @@
 pub mod renderer;
 pub mod shaders;
 pub mod textures;
+pub mod timer;
 pub mod tsaa;
 pub mod uniforms;
 

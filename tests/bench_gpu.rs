@@ -1,0 +1,255 @@
+//! `cumulus bench` and its per-parcel baseline. Needs a GPU adapter (any:
+//! lavapipe in CI); without one each test prints `SKIPPED: no GPU adapter`
+//! and passes, unless `CUMULUS_REQUIRE_GPU=1`.
+
+use std::process::Command;
+
+use cumulus::render::cpu::camera::Camera;
+use cumulus::render::gpu::baseline::{BaselineRenderer, spheres};
+use cumulus::render::gpu::headless::TARGET_FORMAT;
+use cumulus::render::gpu::{GpuContext, Headless, textures};
+use cumulus::render::prepare::Prepared;
+use cumulus::scene::Scene;
+use cumulus::sim::ProjectedField;
+use glam::Vec3;
+
+fn gpu() -> Option<GpuContext> {
+    match GpuContext::new(wgpu::Backends::all()) {
+        Ok(c) => Some(c),
+        Err(e) => {
+            assert!(
+                std::env::var("CUMULUS_REQUIRE_GPU").ok().as_deref() != Some("1"),
+                "CUMULUS_REQUIRE_GPU=1 but: {e}"
+            );
+            eprintln!("SKIPPED: no GPU adapter");
+            None
+        }
+    }
+}
+
+#[test]
+fn bench_quick_writes_well_formed_results() {
+    if gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args(["bench", "--quick", "--out"])
+        .arg(dir.path())
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let mut r = csv::Reader::from_path(dir.path().join("bench.csv")).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(
+        header,
+        "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,frames,p_covered,median_ms,p95_ms,timing"
+            .split(',')
+            .collect::<Vec<_>>()
+    );
+    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    let mut groups = std::collections::BTreeSet::new();
+    let (mut timed, mut total) = (0, 0);
+    for rec in r.records() {
+        total += 1;
+        let rec = rec.unwrap();
+        groups.insert(rec[col("group")].to_owned());
+        assert_eq!(rec.len(), header.len());
+        if &rec[col("timing")] == "skipped" {
+            assert_eq!(
+                &rec[col("renderer")],
+                "per_parcel",
+                "only the baseline may skip"
+            );
+            continue;
+        }
+        assert!(["gpu", "wall"].contains(&&rec[col("timing")]));
+        for c in ["median_ms", "p95_ms"] {
+            let v: f64 = rec[col(c)].parse().unwrap();
+            assert!(v.is_finite() && v > 0.0, "{c} = {v}");
+        }
+        let (m, p): (f64, f64) = (
+            rec[col("median_ms")].parse().unwrap(),
+            rec[col("p95_ms")].parse().unwrap(),
+        );
+        assert!(p >= m, "p95 {p} < median {m}");
+        timed += 1;
+    }
+    assert_eq!(
+        total,
+        2 + 4 + 6 + 2 * 4,
+        "resolutions, coverages, features, parcels x 2"
+    );
+    assert!(timed >= 16, "{timed} timed rows");
+    for g in ["resolution", "coverage", "parcels", "features"] {
+        assert!(groups.contains(g), "no {g} rows");
+    }
+
+    let mut r = csv::Reader::from_path(dir.path().join("physics_in_frame.csv")).unwrap();
+    let mut n = 0;
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        for k in 1..rec.len() {
+            let v: f64 = rec[k].parse().unwrap();
+            assert!(
+                v.is_finite() && v > 0.0,
+                "physics_in_frame column {k} = {v}"
+            );
+        }
+        n += 1;
+    }
+    assert_eq!(n, 4, "12, 85, 1,000 and 10,000 parcels");
+
+    let mut r = csv::Reader::from_path(dir.path().join("render_error.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    for knob in ["steps", "shadow_steps", "octaves", "tsaa_frames"] {
+        let of: Vec<&csv::StringRecord> = rows.iter().filter(|x| &x[0] == knob).collect();
+        assert!(of.len() >= 4, "{knob}");
+        assert_eq!(
+            of.iter().filter(|x| &x[4] == "true").count(),
+            1,
+            "{knob}: one default"
+        );
+        for x in of {
+            let (ms, e): (f64, f64) = (x[2].parse().unwrap(), x[3].parse().unwrap());
+            assert!(
+                ms > 0.0 && ms.is_finite() && (0.0..1.0).contains(&e),
+                "{x:?}"
+            );
+        }
+    }
+
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("bench.json")).unwrap()).unwrap();
+    assert!(json["adapter"].as_str().is_some_and(|s| !s.is_empty()));
+    assert!(json["driver"].is_string());
+    assert_eq!(
+        json["rows"].as_array().map(Vec::len),
+        Some(total),
+        "JSON and CSV rows"
+    );
+    for png in [
+        "ms_vs_coverage.png",
+        "ms_vs_parcels.png",
+        "ms_per_feature.png",
+        "render_error.png",
+    ] {
+        let img = image::open(dir.path().join(png)).unwrap();
+        assert!(img.width() > 100, "{png}");
+    }
+}
+
+/// Cloud mask of an image against the clear sky: channels summed differ
+/// by more than 24 levels.
+fn mask(img: &[u8], clear: &[u8]) -> Vec<bool> {
+    img.chunks_exact(3)
+        .zip(clear.chunks_exact(3))
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| x.abs_diff(*y) as u32)
+                .sum::<u32>()
+                > 24
+        })
+        .collect()
+}
+
+#[test]
+fn baseline_and_cloud_map_draw_the_same_parcels() {
+    let Some(ctx) = gpu() else { return };
+    let mut sc = Scene::load(std::path::Path::new("scenes/fair_weather.toml")).unwrap();
+    sc.render.tsaa = false;
+    let p = Prepared::from_scene(&sc, || {}).unwrap();
+    let l = sc.physics.domain_size_m as f32;
+    // Straight down on the whole domain from above the layer.
+    let camera = Camera {
+        position_m: Vec3::new(0.5 * l, 9_000.0, 0.5 * l),
+        yaw_deg: 0.0,
+        pitch_deg: -89.9,
+        fov_deg: 2.0 * (0.5 * l / 7_500.0_f32).atan().to_degrees(),
+    };
+    let (w, h) = (48, 48);
+    let settings = p.gpu_settings(&sc.render, sc.render.quality());
+    let cloud_map = |field: &ProjectedField| {
+        let mut q = Prepared::from_scene(
+            &{
+                let mut s = sc.clone();
+                s.render.time_s = 0.0;
+                s
+            },
+            || {},
+        )
+        .unwrap();
+        q.field = field.clone();
+        let mut hl = Headless::new(&ctx, &q, &settings, w, h).unwrap();
+        hl.render(&ctx, &camera, 1).unwrap();
+        hl.read_rgb8(&ctx).unwrap()
+    };
+    let baseline = |with_spheres: bool| {
+        let mut b = BaselineRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+        if with_spheres {
+            b.update_spheres(&spheres(
+                &p.parcels,
+                sc.physics.fill_full_condensed_fraction,
+            ));
+        }
+        b.resize(w, h);
+        let t = textures::create_2d(
+            &ctx.device,
+            "t",
+            w,
+            h,
+            TARGET_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let v = t.create_view(&Default::default());
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        b.render(&mut e, &v, &camera, None);
+        ctx.queue.submit([e.finish()]);
+        let px = ctx.read_texture(&t, 4).unwrap();
+        px.chunks_exact(4)
+            .flat_map(|q| [q[0], q[1], q[2]])
+            .collect::<Vec<u8>>()
+    };
+    let clear_sky = baseline(false);
+    let a = mask(&cloud_map(&p.field), &clear_sky);
+    let b = mask(&baseline(true), &clear_sky);
+    let frac = |m: &[bool]| m.iter().filter(|x| **x).count() as f64 / m.len() as f64;
+    // Coarse agreement: 6x6 blocks of 8x8 pixels, cloud fraction per block.
+    let blocks = |m: &[bool]| -> Vec<f64> {
+        (0..36)
+            .map(|k| {
+                let (bx, by) = (k % 6, k / 6);
+                let mut n = 0;
+                for y in by * 8..by * 8 + 8 {
+                    for x in bx * 8..bx * 8 + 8 {
+                        n += m[(y * w as usize) + x] as u32;
+                    }
+                }
+                n as f64 / 64.0
+            })
+            .collect()
+    };
+    let (ba, bb) = (blocks(&a), blocks(&b));
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (ma, mb) = (mean(&ba), mean(&bb));
+    let cov: f64 = ba.iter().zip(&bb).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let sd = |v: &[f64], m: f64| v.iter().map(|x| (x - m).powi(2)).sum::<f64>().sqrt();
+    let corr = cov / (sd(&ba, ma) * sd(&bb, mb)).max(1e-12);
+    eprintln!(
+        "cloud fraction: cloud map {:.2}, baseline {:.2}; block correlation {corr:.2}",
+        frac(&a),
+        frac(&b)
+    );
+    assert!(frac(&a) > 0.05 && frac(&b) > 0.05, "both draw clouds");
+    assert!(
+        frac(&a) / frac(&b) < 3.0 && frac(&b) / frac(&a) < 3.0,
+        "cover within a factor 3"
+    );
+    assert!(
+        corr > 0.4,
+        "the clouds are where the parcels are in both (corr {corr})"
+    );
+}
