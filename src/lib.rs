@@ -21,6 +21,7 @@
 //! ```
 
 pub mod io;
+pub mod panel;
 pub mod render;
 pub mod report;
 pub mod scene;

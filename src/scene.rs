@@ -625,6 +625,75 @@ impl Scene {
         }
     }
 
+    /// The scene as TOML text for a file at `path`: a sounding path is
+    /// rewritten so that it still names the same file from there
+    /// (absolute when the scene's own directory is unknown).
+    pub fn to_toml(&self, path: &Path) -> Result<String, SceneError> {
+        let mut out = self.clone();
+        if let Some(rel) = &self.atmosphere.sounding {
+            let here = self
+                .source
+                .as_deref()
+                .and_then(Path::parent)
+                .map(|d| d.join(rel))
+                .unwrap_or_else(|| rel.clone());
+            let abs = std::fs::canonicalize(&here).unwrap_or(here);
+            let dir = path.parent().and_then(|d| std::fs::canonicalize(d).ok());
+            out.atmosphere.sounding = Some(
+                match dir.and_then(|d| abs.strip_prefix(&d).ok().map(Path::to_owned)) {
+                    Some(r) => r,
+                    None => abs,
+                },
+            );
+        }
+        toml::to_string_pretty(&out).map_err(|e| SceneError::Invalid {
+            path: path.to_owned(),
+            line: None,
+            key: "scene".into(),
+            message: format!("cannot be written as TOML: {e}"),
+        })
+    }
+
+    /// Writes the scene to `path` atomically ([`Self::to_toml`]); it loads
+    /// back with the same settings ([`Self::same_settings`]).
+    pub fn save(&self, path: &Path) -> Result<(), SceneError> {
+        let text = self.to_toml(path)?;
+        crate::io::write_atomically(path, |out| out.write_all(text.as_bytes())).map_err(|source| {
+            SceneError::Io {
+                path: path.to_owned(),
+                source,
+            }
+        })
+    }
+
+    /// Whether two scenes describe the same sky (every section equal, the
+    /// sounding compared by the file it resolves to; the file they came
+    /// from is not compared).
+    pub fn same_settings(&self, other: &Scene) -> bool {
+        let resolve = |s: &Scene| {
+            s.atmosphere.sounding.as_ref().map(|rel| {
+                let p = s
+                    .source
+                    .as_deref()
+                    .and_then(Path::parent)
+                    .map(|d| d.join(rel))
+                    .unwrap_or_else(|| rel.clone());
+                std::fs::canonicalize(&p).unwrap_or(p)
+            })
+        };
+        let strip = |s: &Scene| AtmosphereSection {
+            sounding: None,
+            ..s.atmosphere.clone()
+        };
+        self.name == other.name
+            && self.description == other.description
+            && strip(self) == strip(other)
+            && resolve(self) == resolve(other)
+            && self.physics == other.physics
+            && self.projection == other.projection
+            && self.render == other.render
+    }
+
     /// Builds the atmosphere (reading the sounding, relative to the scene
     /// file, if the scene names one). `sounding_override` replaces it.
     pub fn atmosphere(&self, sounding_override: Option<&Path>) -> Result<Atmosphere, SceneError> {
