@@ -66,17 +66,7 @@ impl Prepared {
 
     /// The GPU renderer's settings for `r` with `quality`.
     pub fn gpu_settings(&self, r: &RenderSettings, quality: Quality) -> GpuSettings {
-        let f = self.frame(r, quality);
-        GpuSettings {
-            density: f.density,
-            quality,
-            sun_elevation_deg: r.sun_elevation_deg,
-            sun_azimuth_deg: r.sun_azimuth_deg,
-            tsaa: r.tsaa.then_some(TsaaSettings {
-                blend: r.tsaa_blend,
-            }),
-            debug_sample_count: false,
-        }
+        gpu_settings(r, self.band, self.map_extent_m, quality)
     }
 
     /// The frame for `settings` with `quality`.
@@ -89,17 +79,43 @@ impl Prepared {
                 p: &self.field,
                 cloud_map: &self.cloud_map,
             },
-            density: DensityParams {
-                band_bottom_m: self.band.bottom_m as f32,
-                band_top_m: self.band.top_m as f32,
-                coverage: r.coverage,
-                extinction_per_m: r.extinction_per_m,
-                map_extent_m: self.map_extent_m as f32,
-                detail_strength: r.detail_strength,
-                detail_scale_m: r.detail_scale_m,
-            },
+            density: density_params(r, self.band, self.map_extent_m),
             quality,
             terrain: self.terrain.as_ref(),
         }
+    }
+}
+
+/// The density's parameters for `[render]` settings `r`, a cloud band and
+/// the map's extent (the physics domain).
+pub fn density_params(r: &RenderSettings, band: Band, map_extent_m: f64) -> DensityParams {
+    DensityParams {
+        band_bottom_m: band.bottom_m as f32,
+        band_top_m: band.top_m as f32,
+        coverage: r.coverage,
+        extinction_per_m: r.extinction_per_m,
+        map_extent_m: map_extent_m as f32,
+        detail_strength: r.detail_strength,
+        detail_scale_m: r.detail_scale_m,
+    }
+}
+
+/// The GPU renderer's settings for `[render]` settings `r` (see
+/// [`density_params`]) with `quality`.
+pub fn gpu_settings(
+    r: &RenderSettings,
+    band: Band,
+    map_extent_m: f64,
+    quality: Quality,
+) -> GpuSettings {
+    GpuSettings {
+        density: density_params(r, band, map_extent_m),
+        quality,
+        sun_elevation_deg: r.sun_elevation_deg,
+        sun_azimuth_deg: r.sun_azimuth_deg,
+        tsaa: r.tsaa.then_some(TsaaSettings {
+            blend: r.tsaa_blend,
+        }),
+        debug_sample_count: false,
     }
 }

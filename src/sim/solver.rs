@@ -235,6 +235,11 @@ impl Simulation {
         &self.atm
     }
 
+    /// Changes the wind from now on (the demo's live control).
+    pub fn set_wind(&mut self, wind: crate::sim::config::Wind) {
+        self.cfg.wind = wind;
+    }
+
     /// The configuration.
     pub fn config(&self) -> &PhysicsConfig {
         &self.cfg

@@ -151,13 +151,13 @@ impl Sounding {
                     format!("`height_m` is {h}, expected >= 0 (height above ground)"),
                 ));
             }
-            if let Some(p) = p {
-                if !(1.0..=1200.0).contains(&p) {
-                    return Err(err(
-                        line,
-                        format!("`pressure_hPa` is {p}, expected 1..=1200"),
-                    ));
-                }
+            if let Some(p) = p
+                && !(1.0..=1200.0).contains(&p)
+            {
+                return Err(err(
+                    line,
+                    format!("`pressure_hPa` is {p}, expected 1..=1200"),
+                ));
             }
             if !(-120.0..=70.0).contains(&t) {
                 return Err(err(
@@ -190,15 +190,15 @@ impl Sounding {
                         ),
                     ));
                 }
-                if let (Some(p), Some(pp)) = (p, prev.p) {
-                    if p >= pp {
-                        return Err(err(
-                            line,
-                            format!(
-                                "`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height"
-                            ),
-                        ));
-                    }
+                if let (Some(p), Some(pp)) = (p, prev.p)
+                    && p >= pp
+                {
+                    return Err(err(
+                        line,
+                        format!(
+                            "`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height"
+                        ),
+                    ));
                 }
             }
             rows.push(Row { line, h, p, t, hum });

@@ -594,6 +594,12 @@ impl CloudRenderer {
         );
     }
 
+    /// Adds, replaces or (with `None`) removes the terrain and its pass.
+    pub fn set_terrain(&mut self, terrain: Option<&Heightfield>) {
+        self.terrain = terrain.map(|h| self.build_terrain(h));
+        self.cloud_pipelines = [None, None];
+    }
+
     /// Replaces the cloud map.
     pub fn update_cloud_map(&mut self, queue: &wgpu::Queue, cloud_map: &CloudMap) {
         let n = cloud_map.size() as u32;
@@ -764,41 +770,40 @@ impl CloudRenderer {
                 usage,
             ));
         }
-        if let Some(t) = &mut self.tsaa {
-            if t.history.is_none() {
-                let make =
-                    |label| textures::create_2d(&self.device, label, w, h, CLOUD_FORMAT, usage);
-                t.history = Some([make("tsaa.history0"), make("tsaa.history1")]);
-                t.distance = Some(textures::create_2d(
-                    &self.device,
-                    "clouds.distance",
-                    w,
-                    h,
-                    DISTANCE_FORMAT,
-                    usage,
-                ));
-                t.frames = 0;
-            }
+        if let Some(t) = &mut self.tsaa
+            && t.history.is_none()
+        {
+            let make = |label| textures::create_2d(&self.device, label, w, h, CLOUD_FORMAT, usage);
+            t.history = Some([make("tsaa.history0"), make("tsaa.history1")]);
+            t.distance = Some(textures::create_2d(
+                &self.device,
+                "clouds.distance",
+                w,
+                h,
+                DISTANCE_FORMAT,
+                usage,
+            ));
+            t.frames = 0;
         }
-        if let Some(t) = &mut self.terrain {
-            if t.color.is_none() {
-                t.color = Some(textures::create_2d(
-                    &self.device,
-                    "terrain.color",
-                    w,
-                    h,
-                    CLOUD_FORMAT,
-                    usage,
-                ));
-                t.depth = Some(textures::create_2d(
-                    &self.device,
-                    "terrain.depth",
-                    w,
-                    h,
-                    DEPTH_FORMAT,
-                    usage,
-                ));
-            }
+        if let Some(t) = &mut self.terrain
+            && t.color.is_none()
+        {
+            t.color = Some(textures::create_2d(
+                &self.device,
+                "terrain.color",
+                w,
+                h,
+                CLOUD_FORMAT,
+                usage,
+            ));
+            t.depth = Some(textures::create_2d(
+                &self.device,
+                "terrain.depth",
+                w,
+                h,
+                DEPTH_FORMAT,
+                usage,
+            ));
         }
     }
 

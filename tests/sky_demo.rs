@@ -1,0 +1,141 @@
+//! The sky demo in a real (virtual) window: under Xvfb with whatever
+//! Vulkan driver exists (lavapipe in CI), `--screenshot` renders a few
+//! frames and saves the last. Needs `xvfb-run` and a GPU adapter; without
+//! them the test prints `SKIPPED` and passes, unless
+//! `CUMULUS_REQUIRE_GPU=1` (set by `.ci/run`, which installs both).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn required() -> bool {
+    std::env::var("CUMULUS_REQUIRE_GPU").ok().as_deref() == Some("1")
+}
+
+/// The demo binary, which `cargo test` builds with the other examples.
+fn sky() -> PathBuf {
+    let exe = std::env::current_exe().expect("test path");
+    let dir = exe.parent().and_then(|d| d.parent()).expect("target dir");
+    dir.join("examples")
+        .join(format!("sky{}", std::env::consts::EXE_SUFFIX))
+}
+
+fn xvfb() -> bool {
+    let ok = Command::new("xvfb-run").arg("--help").output().is_ok();
+    if !ok {
+        assert!(!required(), "CUMULUS_REQUIRE_GPU=1 but xvfb-run is missing");
+        eprintln!("SKIPPED: no xvfb-run");
+    }
+    ok
+}
+
+fn run(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
+    let runtime = tempfile::tempdir().unwrap();
+    let mut c = Command::new("xvfb-run");
+    c.args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(sky())
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", runtime.path());
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("xvfb-run runs")
+}
+
+#[test]
+fn screenshot_shows_sky_and_clouds_in_a_real_window() {
+    if !xvfb() {
+        return;
+    }
+    if cumulus::render::gpu::GpuContext::new(wgpu::Backends::all()).is_err() {
+        assert!(!required(), "CUMULUS_REQUIRE_GPU=1 but no GPU adapter");
+        eprintln!("SKIPPED: no GPU adapter");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("shot.png");
+    let o = run(
+        &[
+            "--scene",
+            "scenes/fair_weather.toml",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--frames",
+            "3",
+            "--width",
+            "800",
+            "--height",
+            "450",
+        ],
+        &[],
+    );
+    assert!(
+        o.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let img = image::open(&shot).expect("a PNG").to_rgb8();
+    assert_eq!(img.dimensions(), (800, 450));
+    // Right of the control panel (about 300 px), the upper two thirds are
+    // sky (blue) with clouds (bright and grey-white).
+    let (mut sky, mut cloud, mut lo, mut hi) = (0, 0, 255u8, 0u8);
+    for y in 0..300 {
+        for x in 400..800 {
+            let [r, g, b] = img.get_pixel(x, y).0;
+            lo = lo.min(g);
+            hi = hi.max(g);
+            if b as f32 > 1.2 * r as f32 && b > 80 {
+                sky += 1;
+            } else if r > 120 && (b as f32) < 1.15 * r as f32 {
+                cloud += 1;
+            }
+        }
+    }
+    eprintln!("sky {sky}, cloud {cloud}, green range {lo}..{hi}");
+    assert!(sky > 5_000, "sky pixels: {sky}");
+    assert!(cloud > 100, "cloud pixels: {cloud}");
+    assert!(hi - lo > 40, "not uniform");
+}
+
+#[test]
+fn no_adapter_is_a_clear_message() {
+    if !xvfb() {
+        return;
+    }
+    let backend = if cfg!(windows) { "metal" } else { "dx12" };
+    let o = run(
+        &["--frames", "1", "--screenshot", "/dev/null"],
+        &[("WGPU_BACKEND", backend)],
+    );
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("no GPU adapter") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_bad_scene_is_named_in_the_error() {
+    if !xvfb() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[render]\nsteps = -3\n").unwrap();
+    let o = run(
+        &[
+            "--scene",
+            bad.to_str().unwrap(),
+            "--frames",
+            "1",
+            "--screenshot",
+            "/dev/null",
+        ],
+        &[],
+    );
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.toml:2"), "{err}");
+}
