@@ -20,6 +20,15 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
+/// `v` with three significant digits, without float noise (an axis label).
+fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
+}
+
 /// Draws the series on log-log axes; `marked` points get a black ring and
 /// a label.
 pub fn loglog_png(
@@ -70,6 +79,8 @@ pub fn loglog_png(
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
+            .x_label_formatter(&|v| significant(*v))
+            .y_label_formatter(&|v| significant(*v))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| err(&e))?;
@@ -150,13 +161,13 @@ pub fn bars_png(
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
-        let n = bars.len().max(1);
+        let n = bars.len().max(2);
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(15)
             .x_label_area_size(45)
             .y_label_area_size(70)
-            .build_cartesian_2d((0..n).into_segmented(), 0.0..top)
+            .build_cartesian_2d((0..n - 1).into_segmented(), 0.0..top)
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
