@@ -20,6 +20,18 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
+/// Registers the embedded font (once) and gives the error constructor
+/// for plots into `path`.
+fn plot_error(path: &Path) -> impl Fn(&dyn std::fmt::Display) -> ReportError + '_ {
+    REGISTER.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+    move |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.to_owned(),
+        message: e.to_string(),
+    }
+}
+
 /// `v` with three significant digits, without float noise (an axis label).
 fn significant(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
@@ -39,13 +51,7 @@ pub fn loglog_png(
     series: &[Series],
     marked: &[(f64, f64, String)],
 ) -> Result<(), ReportError> {
-    REGISTER.call_once(|| {
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-    });
-    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
-        path: path.to_owned(),
-        message: e.to_string(),
-    };
+    let err = plot_error(path);
     let (w, h) = (900u32, 600u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
     let pts = series
@@ -142,13 +148,7 @@ pub fn bars_png(
     y_label: &str,
     bars: &[(String, f64)],
 ) -> Result<(), ReportError> {
-    REGISTER.call_once(|| {
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-    });
-    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
-        path: path.to_owned(),
-        message: e.to_string(),
-    };
+    let err = plot_error(path);
     let (w, h) = (900u32, 600u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
     let top = bars

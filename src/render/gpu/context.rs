@@ -141,6 +141,17 @@ impl GpuContext {
             size,
         );
         self.queue.submit([encoder.finish()]);
+        let data = self.map_read(&buffer)?;
+        let mut out = Vec::with_capacity((row * size.height) as usize);
+        for y in 0..size.height as usize {
+            let start = y * padded as usize;
+            out.extend_from_slice(&data[start..start + row as usize]);
+        }
+        Ok(out)
+    }
+
+    /// Maps a `MAP_READ` buffer, waits for the GPU, and copies it out.
+    pub fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
         let slice = buffer.slice(..);
         let (tx, rx) = mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -152,15 +163,10 @@ impl GpuContext {
             .map_err(|e| GpuError::Readback(e.to_string()))?;
         let data = slice
             .get_mapped_range()
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let mut out = Vec::with_capacity((row * size.height) as usize);
-        for y in 0..size.height as usize {
-            let start = y * padded as usize;
-            out.extend_from_slice(&data[start..start + row as usize]);
-        }
-        drop(data);
+            .map_err(|e| GpuError::Readback(e.to_string()))?
+            .to_vec();
         buffer.unmap();
-        Ok(out)
+        Ok(data)
     }
 
     /// Reads an `Rgba16Float` texture as `f32` RGBA.

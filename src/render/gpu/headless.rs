@@ -11,6 +11,18 @@ use crate::render::prepare::Prepared;
 /// The offscreen target's format: 8-bit sRGB, the CPU `to_srgb8`'s encoding.
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
+/// An offscreen target that can be read back.
+pub fn target(ctx: &GpuContext, width: u32, height: u32) -> wgpu::Texture {
+    textures::create_2d(
+        &ctx.device,
+        "headless.target",
+        width,
+        height,
+        TARGET_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    )
+}
+
 /// A renderer with its own offscreen target.
 pub struct Headless {
     pub renderer: CloudRenderer,
@@ -37,14 +49,7 @@ impl Headless {
             );
             renderer.update_field(&ctx.queue, &prepared.field);
             renderer.resize(width, height);
-            let target = textures::create_2d(
-                &ctx.device,
-                "headless.target",
-                width,
-                height,
-                TARGET_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            );
+            let target = target(ctx, width, height);
             Self { renderer, target }
         })
     }
@@ -52,14 +57,7 @@ impl Headless {
     /// Resizes the renderer and the target.
     pub fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) {
         self.renderer.resize(width, height);
-        self.target = textures::create_2d(
-            &ctx.device,
-            "headless.target",
-            width,
-            height,
-            TARGET_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
+        self.target = target(ctx, width, height);
     }
 
     /// Renders `frames` frames from `camera` (TSAA accumulates across them)

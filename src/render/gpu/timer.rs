@@ -123,20 +123,5 @@ pub fn time_frames(
 }
 
 fn read_u64s(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u64>, GpuError> {
-    let slice = staging.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.wait()?;
-    rx.recv()
-        .map_err(|e| GpuError::Readback(e.to_string()))?
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let v = bytemuck::cast_slice::<u8, u64>(&data).to_vec();
-    drop(data);
-    staging.unmap();
-    Ok(v)
+    Ok(bytemuck::pod_collect_to_vec(&ctx.map_read(staging)?))
 }
