@@ -427,6 +427,8 @@ fn bad_calls_are_errors_not_panics() {
         None,
     );
     renderer.resize(16, 16);
+    // By hand, not `textures::create_2d`: that one never makes a 0x0
+    // texture, and the last check needs one.
     let tex = |format, w, h, usage| {
         ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("test"),
@@ -486,20 +488,7 @@ fn external_depth_keeps_geometry_and_marches_sky_pixels() {
     renderer.update_field(&ctx.queue, &p.field);
     renderer.resize(w, h);
     let make = |format, usage| {
-        ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("test"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
+        cumulus::render::gpu::textures::create_2d(&ctx.device, "test", w, h, format, usage)
     };
     let target = make(
         wgpu::TextureFormat::Rgba8UnormSrgb,
