@@ -87,6 +87,9 @@ struct App {
     frames_done: u32,
     dragging: bool,
     cursor: Option<(f64, f64)>,
+    /// `World::field_version` of the P last uploaded (P and its coverage
+    /// mask are uploaded only when they changed, not while paused).
+    uploaded: Option<u64>,
     error: Option<anyhow::Error>,
 }
 
@@ -122,6 +125,7 @@ impl App {
             frames_done: 0,
             dragging: false,
             cursor: None,
+            uploaded: None,
             error: None,
         })
     }
@@ -275,6 +279,7 @@ impl App {
                         self.world.terrain.as_ref(),
                     );
                     g.clouds.update_field(&g.queue, &self.world.field);
+                    self.uploaded = Some(self.world.field_version);
                     g.clouds.resize(width, height);
                 }
                 self.message = Some(format!("loaded {}", path.display()));
@@ -356,7 +361,10 @@ impl App {
                 g.clouds.set_settings(&settings_of(&self.world));
             }
         }
-        g.clouds.update_field(&g.queue, &self.world.field);
+        if self.uploaded != Some(self.world.field_version) {
+            g.clouds.update_field(&g.queue, &self.world.field);
+            self.uploaded = Some(self.world.field_version);
+        }
 
         // Nothing to draw into while minimised.
         let (width, height) = g.clouds.size();
