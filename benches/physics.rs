@@ -47,7 +47,7 @@ fn physics(c: &mut Criterion) {
         let sim = spun_up(n);
         let mut field = ProjectedField::new(128, 128);
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
-            b.iter(|| field.project(sim.parcels(), sim.config().domain_size_m, BAND, 0.08))
+            b.iter(|| sim.project_into(&mut field, BAND))
         });
     }
     g.finish();
@@ -57,7 +57,7 @@ fn physics(c: &mut Criterion) {
     g.bench_function("10000", |b| {
         b.iter(|| {
             sim.step();
-            field.project(sim.parcels(), sim.config().domain_size_m, BAND, 0.08)
+            sim.project_into(&mut field, BAND)
         })
     });
     g.finish();

@@ -3,9 +3,9 @@
 //! `cargo bench --bench render`
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use cumulus::prepare::Prepared;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::renderer::render_linear;
-use cumulus::render::prepare::Prepared;
 use cumulus::scene::Scene;
 
 fn render(c: &mut Criterion) {

@@ -8,15 +8,15 @@
 //! `cargo run --release --example embed -- [OUT.png]`
 
 use anyhow::{Context, Result};
+use cumulus::prepare::{gpu_settings, spawn_sites};
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::camera::Camera;
-use cumulus::render::cpu::density::DensityParams;
-use cumulus::render::cpu::renderer::RenderSettings;
-use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings, TsaaSettings};
+use cumulus::render::gpu::{CloudRenderer, GpuContext};
+use cumulus::scene::RenderSettings;
 use cumulus::sim::{
     Atmosphere, Band, ParametricProfile, PhysicsConfig, ProjectedField, Simulation,
 };
-use glam::{DVec2, Vec3};
+use glam::Vec3;
 
 fn main() -> Result<()> {
     let out = std::env::args()
@@ -54,37 +54,21 @@ fn main() -> Result<()> {
         physics,
         Atmosphere::from_parametric(&ParametricProfile::FAIR_WEATHER),
     );
-    sim.set_spawn_sites(
-        cloud_map
-            .cell_centres(64)
-            .into_iter()
-            .map(|(u, v)| DVec2::new(u as f64 * extent, v as f64 * extent))
-            .collect(),
-    );
+    sim.set_spawn_sites(spawn_sites(&cloud_map, extent));
     let band = Band {
         bottom_m: 600.0,
         top_m: 1600.0,
     };
     let mut field = ProjectedField::new(128, 128);
 
-    // The renderer: settings from the defaults of a scene's [render] table.
-    let defaults = RenderSettings::default();
-    let settings = GpuSettings {
-        density: DensityParams {
-            band_bottom_m: band.bottom_m as f32,
-            band_top_m: band.top_m as f32,
-            coverage: defaults.coverage,
-            extinction_per_m: defaults.extinction_per_m,
-            map_extent_m: extent as f32,
-            detail_strength: defaults.detail_strength,
-            detail_scale_m: defaults.detail_scale_m,
-        },
-        quality: defaults.quality(),
+    // The renderer: settings from a scene's [render] table (its defaults,
+    // with the sun moved), the band and the map's extent.
+    let look = RenderSettings {
         sun_elevation_deg: 35.0,
         sun_azimuth_deg: 140.0,
-        tsaa: Some(TsaaSettings::default()),
-        debug_sample_count: false,
+        ..RenderSettings::default()
     };
+    let settings = gpu_settings(&look, band, extent, look.quality());
     let mut clouds = CloudRenderer::new(device, queue, format, &settings, &cloud_map, None);
     clouds.resize(width, height);
 
@@ -95,7 +79,7 @@ fn main() -> Result<()> {
     }
     for frame in 0..16 {
         sim.step();
-        field.project(sim.parcels(), extent, band, 0.08);
+        sim.project_into(&mut field, band);
         clouds.update_field(queue, &field);
         let camera = Camera {
             position_m: Vec3::new(0.0, 100.0, 0.0),

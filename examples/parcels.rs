@@ -32,12 +32,7 @@ fn main() {
         for _ in 0..frames_per_minute {
             substeps += sim.step().substeps;
         }
-        field.project(
-            sim.parcels(),
-            sim.config().domain_size_m,
-            band,
-            sim.config().fill_full_condensed_fraction,
-        );
+        sim.project_into(&mut field, band);
         if minute % 10 == 0 {
             let p = sim.parcels();
             let cloudy = p.diag.iter().filter(|d| d.qc > 0.0).count();

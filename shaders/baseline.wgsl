@@ -11,7 +11,7 @@ struct Sphere {
     fill: vec4f,          // fill density 0..1, unused x3
 }
 
-@group(1) @binding(1) var<storage, read> spheres: array<Sphere>;
+@group(1) @binding(0) var<storage, read> spheres: array<Sphere>;
 
 // Extinction (1/m) at p: the sum of every sphere's parabolic profile,
 // eroded by the detail noise when it is on. O(parcels).
@@ -66,7 +66,7 @@ fn sphere_optical_depth(p: vec3f, sun_dir: vec3f) -> f32 {
     var t = 0.0;
     var tau = 0.0;
     for (var i = 0u; i < SHADOW_STEPS; i++) {
-        let dt = 2000.0 * f32(i + 1u) / parts;
+        let dt = SHADOW_RAY_M * f32(i + 1u) / parts;
         tau += sphere_density(p + sun_dir * (t + 0.5 * dt), false) * dt;
         t += dt;
     }

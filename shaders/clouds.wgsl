@@ -21,6 +21,8 @@ const REFINE: u32 = 4u;
 const ALBEDO: f32 = 0.99;
 const MIN_TRANSMITTANCE: f32 = 0.01;
 const SUN_DISK_COS: f32 = 0.999989;
+// The longest shadow ray toward the sun, m.
+const SHADOW_RAY_M: f32 = 2000.0;
 
 // Mirrors `FrameUniforms` in src/render/gpu/uniforms.rs (352 bytes).
 struct Frame {
@@ -189,11 +191,11 @@ fn sun_optical_depth(p: vec3f, sun_dir: vec3f) -> f32 {
     if SHADOW_STEPS == 0u {
         return 0.0;
     }
-    var to_top = 2000.0;
+    var to_top = SHADOW_RAY_M;
     if sun_dir.y > 1e-3 {
         to_top = max(frame.band.y - p.y, 0.0) / sun_dir.y;
     }
-    let length = min(to_top, 2000.0);
+    let length = min(to_top, SHADOW_RAY_M);
     let parts = f32(SHADOW_STEPS * (SHADOW_STEPS + 1u) / 2u);
     var t = 0.0;
     var tau = 0.0;

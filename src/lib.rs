@@ -16,12 +16,13 @@
 //! }
 //! let mut p = ProjectedField::new(64, 64);
 //! let band = cumulus::sim::Band { bottom_m: 600.0, top_m: 1500.0 };
-//! p.project(sim.parcels(), sim.config().domain_size_m, band, 0.08);
+//! sim.project_into(&mut p, band);
 //! assert!(sim.parcels().pos.iter().all(|x| x.is_finite()));
 //! ```
 
 pub mod io;
 pub mod panel;
+pub mod prepare;
 pub mod render;
 pub mod report;
 pub mod scene;

@@ -4,28 +4,18 @@
 
 use std::process::Command;
 
+mod common;
+
+use common::gpu;
+
+use cumulus::prepare::Prepared;
 use cumulus::render::cpu::camera::Camera;
-use cumulus::render::gpu::baseline::{BaselineRenderer, spheres};
+use cumulus::render::gpu::baseline::BaselineRenderer;
 use cumulus::render::gpu::headless::TARGET_FORMAT;
-use cumulus::render::gpu::{GpuContext, Headless, textures};
-use cumulus::render::prepare::Prepared;
+use cumulus::render::gpu::{Headless, textures};
 use cumulus::scene::Scene;
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
-
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(wgpu::Backends::all()) {
-        Ok(c) => Some(c),
-        Err(e) => {
-            assert!(
-                std::env::var("CUMULUS_REQUIRE_GPU").ok().as_deref() != Some("1"),
-                "CUMULUS_REQUIRE_GPU=1 but: {e}"
-            );
-            eprintln!("SKIPPED: no GPU adapter");
-            None
-        }
-    }
-}
 
 #[test]
 fn bench_quick_writes_well_formed_results() {
@@ -173,27 +163,14 @@ fn baseline_and_cloud_map_draw_the_same_parcels() {
     let (w, h) = (48, 48);
     let settings = p.gpu_settings(&sc.render, sc.render.quality());
     let cloud_map = |field: &ProjectedField| {
-        let mut q = Prepared::from_scene(
-            &{
-                let mut s = sc.clone();
-                s.render.time_s = 0.0;
-                s
-            },
-            || {},
-        )
-        .unwrap();
-        q.field = field.clone();
-        let mut hl = Headless::new(&ctx, &q, &settings, w, h).unwrap();
+        let mut hl = Headless::new(&ctx, field, &p.cloud_map, None, &settings, (w, h)).unwrap();
         hl.render(&ctx, &camera, 1).unwrap();
         hl.read_rgb8(&ctx).unwrap()
     };
     let baseline = |with_spheres: bool| {
         let mut b = BaselineRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
         if with_spheres {
-            b.update_spheres(&spheres(
-                &p.parcels,
-                sc.physics.fill_full_condensed_fraction,
-            ));
+            b.update_spheres(&p.spheres());
         }
         b.resize(w, h);
         let t = textures::create_2d(

@@ -1,4 +1,4 @@
-//! Analytic invariants of the parcel physics (physics.md section 4).
+//! Analytic invariants of the parcel physics.
 
 use cumulus::sim::config::PhysicsConfig;
 use cumulus::sim::constants::{C_P, G};

@@ -3,29 +3,14 @@
 //! Without one each test prints `SKIPPED: no GPU adapter` and passes,
 //! unless `CUMULUS_REQUIRE_GPU=1` (set by `.ci/run`).
 
-use cumulus::render::cpu::renderer::{RenderSettings, render_linear, to_srgb8};
-use cumulus::render::gpu::renderer::{PASS_CLOUDS, PASS_COMPOSITE, PASS_TERRAIN, PASS_TSAA};
-use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuError, Headless, RenderError};
-use cumulus::render::prepare::Prepared;
-use cumulus::scene::Scene;
-use glam::Vec3;
+mod common;
 
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(wgpu::Backends::all()) {
-        Ok(c) => {
-            eprintln!("adapter: {}", c.describe());
-            Some(c)
-        }
-        Err(GpuError::NoAdapter) => {
-            if std::env::var("CUMULUS_REQUIRE_GPU").is_ok_and(|v| v == "1") {
-                panic!("CUMULUS_REQUIRE_GPU=1 but no GPU adapter was found");
-            }
-            eprintln!("SKIPPED: no GPU adapter");
-            None
-        }
-        Err(e) => panic!("GPU device: {e}"),
-    }
-}
+use common::gpu;
+use cumulus::prepare::Prepared;
+use cumulus::render::cpu::renderer::{render_linear, supersampled_srgb8, to_srgb8};
+use cumulus::render::gpu::renderer::{PASS_CLOUDS, PASS_COMPOSITE, PASS_TERRAIN, PASS_TSAA};
+use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuError, RenderError};
+use cumulus::scene::{RenderSettings, Scene};
 
 fn scene(name: &str) -> Scene {
     Scene::load(std::path::Path::new(&format!("scenes/{name}.toml"))).expect("shipped scene")
@@ -75,8 +60,9 @@ fn parity(ctx: &GpuContext, sc: &Scene, sizes: &[(u32, u32)], mean_bound: f64, m
         };
         let q = r.quality();
         let cpu = to_srgb8(&render_linear(w, h, &prepared.frame(&r, q)), q.exposure);
-        let mut hl =
-            Headless::new(ctx, &prepared, &prepared.gpu_settings(&r, q), w, h).expect("renderer");
+        let mut hl = prepared
+            .headless(ctx, &prepared.gpu_settings(&r, q), w, h)
+            .expect("renderer");
         hl.render(ctx, &r.camera(), 1).expect("frame");
         let gpu = hl.read_rgb8(ctx).expect("readback");
         let (mean, max) = diff(&cpu, &gpu);
@@ -141,8 +127,9 @@ fn each_scene_builds_only_the_passes_it_needs() {
     let sc = scene("fair_weather");
     let p = Prepared::from_scene(&sc, || {}).expect("prepare");
     let r = &sc.render;
-    let mut hl =
-        Headless::new(&ctx, &p, &p.gpu_settings(r, r.quality()), 32, 24).expect("renderer");
+    let mut hl = p
+        .headless(&ctx, &p.gpu_settings(r, r.quality()), 32, 24)
+        .expect("renderer");
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     assert_eq!(
         hl.renderer.last_passes(),
@@ -164,8 +151,9 @@ fn each_scene_builds_only_the_passes_it_needs() {
     sc.render.terrain.size = 32;
     let p = Prepared::from_scene(&sc, || {}).expect("prepare");
     let r = &sc.render;
-    let mut hl =
-        Headless::new(&ctx, &p, &p.gpu_settings(r, r.quality()), 32, 24).expect("renderer");
+    let mut hl = p
+        .headless(&ctx, &p.gpu_settings(r, r.quality()), 32, 24)
+        .expect("renderer");
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     assert_eq!(
         hl.renderer.last_passes(),
@@ -217,7 +205,7 @@ fn per_pixel_work_is_bounded_the_same_for_12_and_10000_parcels() {
         let mut s = p.gpu_settings(r, q);
         s.debug_sample_count = true;
         s.tsaa = None;
-        let mut hl = Headless::new(&ctx, &p, &s, 64, 48).expect("renderer");
+        let mut hl = p.headless(&ctx, &s, 64, 48).expect("renderer");
         hl.render(&ctx, &r.camera(), 1).expect("frame");
         let counts: Vec<f32> = cloud_layer(&ctx, &hl.renderer)
             .iter()
@@ -251,7 +239,7 @@ fn the_same_p_costs_the_same_whatever_made_it() {
     let mut s = p.gpu_settings(r, r.quality());
     s.debug_sample_count = true;
     s.tsaa = None;
-    let mut hl = Headless::new(&ctx, &p, &s, 48, 32).expect("renderer");
+    let mut hl = p.headless(&ctx, &s, 48, 32).expect("renderer");
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     let a = cloud_layer(&ctx, &hl.renderer);
     let copy = cumulus::sim::ProjectedField::from_texels(
@@ -270,15 +258,7 @@ fn the_same_p_costs_the_same_whatever_made_it() {
 fn supersampled_reference(p: &Prepared, r: &RenderSettings, w: u32, h: u32) -> Vec<u8> {
     let mut q = r.quality();
     q.steps = 192;
-    let s = 4;
-    let fine = render_linear(w * s, h * s, &p.frame(&RenderSettings { ..r.clone() }, q));
-    let mut out = vec![Vec3::ZERO; (w * h) as usize];
-    for y in 0..h * s {
-        for x in 0..w * s {
-            out[((y / s) * w + x / s) as usize] += fine[(y * w * s + x) as usize] / (s * s) as f32;
-        }
-    }
-    to_srgb8(&out, q.exposure)
+    supersampled_srgb8(w, h, 4, &p.frame(r, q))
 }
 
 fn tsaa_scene() -> (Scene, Prepared) {
@@ -296,7 +276,9 @@ fn tsaa_converges_toward_the_reference_with_a_static_camera() {
     let (w, h) = (80, 60);
     let r = &sc.render;
     let reference = supersampled_reference(&p, r, w, h);
-    let mut hl = Headless::new(&ctx, &p, &p.gpu_settings(r, r.quality()), w, h).expect("renderer");
+    let mut hl = p
+        .headless(&ctx, &p.gpu_settings(r, r.quality()), w, h)
+        .expect("renderer");
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     let (one, _) = diff(&reference, &hl.read_rgb8(&ctx).expect("readback"));
     hl.render(&ctx, &r.camera(), 31).expect("frames");
@@ -321,7 +303,7 @@ fn tsaa_reprojects_a_rotation_without_ghosting() {
     };
     let settings = p.gpu_settings(r, r.quality());
     // Converged at A, then one frame at B.
-    let mut moved = Headless::new(&ctx, &p, &settings, w, h).expect("renderer");
+    let mut moved = p.headless(&ctx, &settings, w, h).expect("renderer");
     moved.render(&ctx, &a, 32).expect("frames");
     let at_a = moved.read_rgb8(&ctx).expect("readback");
     moved.render(&ctx, &b, 1).expect("frame");
@@ -332,7 +314,7 @@ fn tsaa_reprojects_a_rotation_without_ghosting() {
     );
     let after = moved.read_rgb8(&ctx).expect("readback");
     // Converged at B from the start.
-    let mut still = Headless::new(&ctx, &p, &settings, w, h).expect("renderer");
+    let mut still = p.headless(&ctx, &settings, w, h).expect("renderer");
     still.render(&ctx, &b, 32).expect("frames");
     let at_b = still.read_rgb8(&ctx).expect("readback");
     let (ghost, _) = diff(&after, &at_b);
@@ -353,8 +335,9 @@ fn tsaa_history_resets_on_resize_and_cut() {
     let Some(ctx) = gpu() else { return };
     let (sc, p) = tsaa_scene();
     let r = &sc.render;
-    let mut hl =
-        Headless::new(&ctx, &p, &p.gpu_settings(r, r.quality()), 48, 32).expect("renderer");
+    let mut hl = p
+        .headless(&ctx, &p.gpu_settings(r, r.quality()), 48, 32)
+        .expect("renderer");
     hl.render(&ctx, &r.camera(), 8).expect("frames");
     assert_eq!(hl.renderer.history_frames(), 8);
     hl.resize(&ctx, 50, 30);
@@ -363,8 +346,9 @@ fn tsaa_history_resets_on_resize_and_cut() {
     // The first frame after a reset is that frame alone: the same image as
     // a fresh renderer at the same jitter phase.
     let after_resize = hl.read_rgb8(&ctx).expect("readback");
-    let mut fresh =
-        Headless::new(&ctx, &p, &p.gpu_settings(r, r.quality()), 50, 30).expect("renderer");
+    let mut fresh = p
+        .headless(&ctx, &p.gpu_settings(r, r.quality()), 50, 30)
+        .expect("renderer");
     fresh.renderer.set_frame_index(8);
     fresh.render(&ctx, &r.camera(), 1).expect("frame");
     assert_eq!(after_resize, fresh.read_rgb8(&ctx).expect("readback"));
@@ -382,7 +366,9 @@ fn odd_and_zero_sizes_and_a_storm_of_resizes() {
     let sc = scene("fair_weather");
     let p = Prepared::from_scene(&sc, || {}).expect("prepare");
     let r = &sc.render;
-    let mut hl = Headless::new(&ctx, &p, &p.gpu_settings(r, r.quality()), 1, 1).expect("renderer");
+    let mut hl = p
+        .headless(&ctx, &p.gpu_settings(r, r.quality()), 1, 1)
+        .expect("renderer");
     for (k, (w, h)) in [
         (1, 1),
         (3, 7),

@@ -1,4 +1,4 @@
-//! The stability matrix (physics.md section 4): every combination of time
+//! The stability matrix: every combination of time
 //! step, surface humidity, inversion strength and parcel layout stays finite,
 //! keeps its parcel count and closes its water books; nothing panics.
 

@@ -13,6 +13,8 @@
 //! and exits. Without a GPU adapter it says how to install software Vulkan.
 
 mod camera;
+mod gfx;
+mod screenshot;
 mod ui;
 mod world;
 
@@ -20,10 +22,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result};
 use clap::Parser;
-use cumulus::render::gpu::{CloudRenderer, GpuSettings};
-use cumulus::render::prepare::gpu_settings;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -31,6 +31,7 @@ use winit::keyboard::PhysicalKey;
 use winit::window::{Window, WindowId};
 
 use crate::camera::Controller;
+use crate::gfx::{Gfx, settings_of};
 use crate::world::World;
 
 #[derive(Parser, Debug, Clone)]
@@ -56,20 +57,6 @@ struct Args {
     hide_panel: bool,
 }
 
-/// The GPU side: surface, device, the cloud renderer and egui's renderer.
-struct Gfx {
-    surface: wgpu::Surface<'static>,
-    device: wgpu::Device,
-    queue: wgpu::Queue,
-    config: wgpu::SurfaceConfiguration,
-    clouds: CloudRenderer,
-    egui: egui_wgpu::Renderer,
-    /// Timestamp queries of the renderer's passes, when supported.
-    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
-    period_ns: f64,
-    description: String,
-}
-
 struct App {
     args: Args,
     window: Option<Arc<Window>>,
@@ -91,16 +78,6 @@ struct App {
     /// mask are uploaded only when they changed, not while paused).
     uploaded: Option<u64>,
     error: Option<anyhow::Error>,
-}
-
-fn settings_of(world: &World) -> GpuSettings {
-    let r = &world.scene.render;
-    gpu_settings(
-        r,
-        world.band,
-        world.scene.physics.domain_size_m,
-        r.quality(),
-    )
 }
 
 impl App {
@@ -141,113 +118,16 @@ impl App {
                     )),
             )?,
         );
-        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
-        let surface = instance.create_surface(window.clone()).map_err(|e| {
-            anyhow!(
-                "no GPU adapter can draw to this window ({e}). Install a Vulkan driver (on Debian/Ubuntu, software Vulkan: `sudo apt-get install mesa-vulkan-drivers`), or use `cumulus render --backend cpu` for still pictures"
-            )
-        })?;
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: Some(&surface),
-            apply_limit_buckets: false,
-        }))
-        .map_err(|_| {
-            anyhow!(
-                "no GPU adapter can draw to this window. Install a Vulkan driver (on Debian/Ubuntu, software Vulkan: `sudo apt-get install mesa-vulkan-drivers`), or use `cumulus render --backend cpu` for still pictures"
-            )
-        })?;
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("sky"),
-            required_features: if timestamps {
-                wgpu::Features::TIMESTAMP_QUERY
-            } else {
-                wgpu::Features::empty()
-            },
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
-            ..Default::default()
-        }))
-        .context("requesting a device")?;
-        let size = window.inner_size();
-        let mut config = surface
-            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
-            .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
-        let caps = surface.get_capabilities(&adapter);
-        if let Some(f) = caps.formats.iter().find(|f| f.is_srgb()) {
-            config.format = *f;
-        }
-        if caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
-            config.usage |= wgpu::TextureUsages::COPY_SRC;
-        }
-        if size.width > 0 && size.height > 0 {
-            surface.configure(&device, &config);
-        }
-        let mut clouds = CloudRenderer::new(
-            &device,
-            &queue,
-            config.format,
-            &settings_of(&self.world),
-            &self.world.cloud_map,
-            self.world.terrain.as_ref(),
-        );
-        clouds.update_field(&queue, &self.world.field);
-        clouds.resize(size.width, size.height);
-        let ts = timestamps.then(|| {
-            let q = device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("sky.timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 8,
-            });
-            let buf = |label, usage| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size: 64,
-                    usage,
-                    mapped_at_creation: false,
-                })
-            };
-            (
-                q,
-                buf(
-                    "sky.timestamps.resolve",
-                    wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                ),
-                buf(
-                    "sky.timestamps.read",
-                    wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                ),
-            )
-        });
-        let egui = egui_wgpu::Renderer::new(
-            &device,
-            config.format,
-            egui_wgpu::RendererOptions::default(),
-        );
+        let gfx = Gfx::new(window.clone(), &self.world)?;
         self.egui_state = Some(egui_winit::State::new(
             self.egui_ctx.clone(),
             egui::ViewportId::ROOT,
             &window,
             Some(window.scale_factor() as f32),
             None,
-            Some(device.limits().max_texture_dimension_2d as usize),
+            Some(gfx.ctx.device.limits().max_texture_dimension_2d as usize),
         ));
-        let info = adapter.get_info();
-        self.gfx = Some(Gfx {
-            period_ns: queue.get_timestamp_period() as f64,
-            surface,
-            device,
-            queue,
-            config,
-            clouds,
-            egui,
-            timestamps: ts,
-            description: format!("{} ({:?})", info.name, info.backend),
-        });
+        self.gfx = Some(gfx);
         self.window = Some(window);
         Ok(())
     }
@@ -258,7 +138,7 @@ impl App {
         if width > 0 && height > 0 {
             g.config.width = width;
             g.config.height = height;
-            g.surface.configure(&g.device, &g.config);
+            g.surface.configure(&g.ctx.device, &g.config);
         }
     }
 
@@ -269,18 +149,8 @@ impl App {
                 self.camera = Controller::new(self.world.scene.render.camera());
                 self.views = ui::Views::default();
                 if let Some(g) = &mut self.gfx {
-                    let (width, height) = g.clouds.size();
-                    g.clouds = CloudRenderer::new(
-                        &g.device,
-                        &g.queue,
-                        g.config.format,
-                        &settings_of(&self.world),
-                        &self.world.cloud_map,
-                        self.world.terrain.as_ref(),
-                    );
-                    g.clouds.update_field(&g.queue, &self.world.field);
+                    g.rebuild_clouds(&self.world);
                     self.uploaded = Some(self.world.field_version);
-                    g.clouds.resize(width, height);
                 }
                 self.message = Some(format!("loaded {}", path.display()));
             }
@@ -362,7 +232,7 @@ impl App {
             }
         }
         if self.uploaded != Some(self.world.field_version) {
-            g.clouds.update_field(&g.queue, &self.world.field);
+            g.clouds.update_field(&g.ctx.queue, &self.world.field);
             self.uploaded = Some(self.world.field_version);
         }
 
@@ -375,7 +245,7 @@ impl App {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                g.surface.configure(&g.device, &g.config);
+                g.surface.configure(&g.ctx.device, &g.config);
                 return Ok(());
             }
             _ => return Ok(()),
@@ -384,6 +254,7 @@ impl App {
             .texture
             .create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = g
+            .ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("sky.frame"),
@@ -413,12 +284,13 @@ impl App {
             .tessellate(out.shapes, screen.pixels_per_point);
         for (id, deltas) in &out.textures_delta.set {
             for delta in deltas {
-                g.egui.update_texture(&g.device, &g.queue, *id, delta);
+                g.egui
+                    .update_texture(&g.ctx.device, &g.ctx.queue, *id, delta);
             }
         }
-        let extra = g
-            .egui
-            .update_buffers(&g.device, &g.queue, &mut encoder, &jobs, &screen);
+        let extra =
+            g.egui
+                .update_buffers(&g.ctx.device, &g.ctx.queue, &mut encoder, &jobs, &screen);
         {
             let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("egui"),
@@ -442,33 +314,12 @@ impl App {
             g.egui.free_texture(id);
         }
         let last = screenshot && self.frames_done + 1 >= self.args.frames;
-        let readback = last.then(|| {
-            let w = frame.texture.width();
-            let h = frame.texture.height();
-            let row = (4 * w).div_ceil(256) * 256;
-            let buf = g.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("sky.screenshot"),
-                size: row as u64 * h as u64,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            encoder.copy_texture_to_buffer(
-                frame.texture.as_image_copy(),
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buf,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(row),
-                        rows_per_image: Some(h),
-                    },
-                },
-                frame.texture.size(),
-            );
-            (buf, row, w, h)
-        });
-        g.queue.submit(extra.into_iter().chain([encoder.finish()]));
+        let readback = last.then(|| screenshot::copy(&g.ctx.device, &mut encoder, &frame.texture));
+        g.ctx
+            .queue
+            .submit(extra.into_iter().chain([encoder.finish()]));
         if read_timestamps && let Some((_, _, read)) = &g.timestamps {
-            let ticks = map_read(&g.device, read)?;
+            let ticks = g.ctx.map_read(read)?;
             let t: &[u64] = bytemuck::cast_slice(&ticks);
             // The cloud pass is the first pass, or the second after terrain.
             let k = g
@@ -480,26 +331,9 @@ impl App {
             self.timings.cloud_pass_ms =
                 Some(t[2 * k + 1].saturating_sub(t[2 * k]) as f64 * g.period_ns * 1e-6);
         }
-        if let Some((buf, row, w, h)) = readback {
-            let data = map_read(&g.device, &buf)?;
-            let bgra = matches!(
-                g.config.format,
-                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-            );
-            let mut rgb = Vec::with_capacity((w * h * 3) as usize);
-            for y in 0..h as usize {
-                for px in data[y * row as usize..][..4 * w as usize].chunks_exact(4) {
-                    if bgra {
-                        rgb.extend([px[2], px[1], px[0]]);
-                    } else {
-                        rgb.extend([px[0], px[1], px[2]]);
-                    }
-                }
-            }
-            let img = image::RgbImage::from_raw(w, h, rgb).context("screenshot size")?;
+        if let Some(r) = readback {
             let path = self.args.screenshot.clone().unwrap_or_default();
-            cumulus::io::write_png_atomically(&path, &img)
-                .with_context(|| format!("{}: cannot write", path.display()))?;
+            let (w, h) = screenshot::save(&g.ctx, r, g.config.format, &path)?;
             println!(
                 "wrote {} ({w}x{h}, {} frames, {})",
                 path.display(),
@@ -508,27 +342,13 @@ impl App {
             );
         }
         window.pre_present_notify();
-        g.queue.present(frame);
+        g.ctx.queue.present(frame);
         self.frames_done += 1;
         if last {
             event_loop.exit();
         }
         Ok(())
     }
-}
-
-/// Maps `buffer` for reading and waits.
-fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    device.poll(wgpu::PollType::wait_indefinitely())?;
-    rx.recv()??;
-    let v = slice.get_mapped_range()?.to_vec();
-    buffer.unmap();
-    Ok(v)
 }
 
 impl ApplicationHandler for App {

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use cumulus::panel::PanelState;
+use cumulus::prepare::spawn_sites;
 use cumulus::render::cloud_map::CloudMap;
 use cumulus::render::terrain::Heightfield;
 use cumulus::scene::{Scene, SceneError};
 use cumulus::sim::{Atmosphere, Band, ProjectedField, Simulation};
-use glam::DVec2;
 
 /// One sample of the picked parcel's curves.
 #[derive(Debug, Clone, Copy)]
@@ -97,13 +97,7 @@ impl World {
     pub fn restart_simulation(&mut self) {
         let l = self.scene.physics.domain_size_m;
         let mut sim = Simulation::new(self.scene.physics.clone(), self.atmosphere.clone());
-        sim.set_spawn_sites(
-            self.cloud_map
-                .cell_centres(64)
-                .into_iter()
-                .map(|(u, v)| DVec2::new(u as f64 * l, v as f64 * l))
-                .collect(),
-        );
+        sim.set_spawn_sites(spawn_sites(&self.cloud_map, l));
         let dt = self.scene.physics.dt_s;
         for _ in 0..(SPIN_UP_S / dt) as usize {
             sim.step();
@@ -141,12 +135,7 @@ impl World {
     /// Projects the parcels into P.
     pub fn project(&mut self) {
         let start = Instant::now();
-        self.field.project(
-            self.sim.parcels(),
-            self.scene.physics.domain_size_m,
-            self.band,
-            self.scene.physics.fill_full_condensed_fraction,
-        );
+        self.sim.project_into(&mut self.field, self.band);
         self.projection_ms = start.elapsed().as_secs_f64() * 1e3;
         self.field_version += 1;
     }

@@ -1,9 +1,10 @@
-//! Rendering: the cloud map, and the CPU reference renderer (the oracle
-//! and fallback that the wgpu renderer will be tested against).
+//! Rendering: the cloud map, the terrain, the wgpu renderer and its twin,
+//! the CPU reference renderer (the oracle the GPU is tested against and
+//! the fallback without a GPU). Sees the simulation only through P
+//! (`sim::ProjectedField`, `sim::Band`).
 
 pub mod cloud_map;
 pub mod coverage_mask;
 pub mod cpu;
 pub mod gpu;
-pub mod prepare;
 pub mod terrain;

@@ -4,6 +4,182 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::check::Check;
+
+impl PhysicsConfig {
+    /// Every field against its domain (the scene reports the first that
+    /// fails).
+    pub fn checks(&self) -> Vec<Check> {
+        let p = self;
+        let r = Check::range;
+        vec![
+            r("physics.dt_s", p.dt_s, 1e-3, 600.0, "1e-3..=600 s"),
+            Check::new(
+                "physics.parcels",
+                p.parcels <= 200_000,
+                "0..=200000",
+                p.parcels as f64,
+            ),
+            r(
+                "physics.domain_size_m",
+                p.domain_size_m,
+                1.0,
+                1e7,
+                "1..=1e7 m",
+            ),
+            r("physics.radius_m", p.radius_m, 1e-3, 1e5, "a radius > 0 m"),
+            r("physics.radius_jitter", p.radius_jitter, 0.0, 0.99, "0..<1"),
+            r(
+                "physics.release_height_m",
+                p.release_height_m,
+                0.0,
+                1e5,
+                ">= 0 m",
+            ),
+            r(
+                "physics.release_stagger_s",
+                p.release_stagger_s,
+                0.0,
+                1e7,
+                ">= 0 s",
+            ),
+            r(
+                "physics.initial_excess_k",
+                p.initial_excess_k,
+                -50.0,
+                50.0,
+                "-50..=50 K",
+            ),
+            r(
+                "physics.initial_excess_qt_gkg",
+                p.initial_excess_qt_gkg,
+                -50.0,
+                50.0,
+                "-50..=50 g/kg",
+            ),
+            r("physics.virtual_mass", p.virtual_mass, 0.0, 2.0, "0..=2"),
+            r(
+                "physics.drag_coefficient",
+                p.drag_coefficient,
+                0.0,
+                5.0,
+                "0..=5",
+            ),
+            r(
+                "physics.fill_full_condensed_fraction",
+                p.fill_full_condensed_fraction,
+                1e-6,
+                1.0,
+                "(0, 1]",
+            ),
+            r(
+                "physics.entrainment.coefficient",
+                p.entrainment.coefficient,
+                0.0,
+                2.0,
+                "0..=2",
+            ),
+            r(
+                "physics.detrainment.rate_per_s",
+                p.detrainment.rate_per_s,
+                0.0,
+                1.0,
+                "0..=1 1/s",
+            ),
+            r(
+                "physics.detrainment.sorting_factor",
+                p.detrainment.sorting_factor,
+                0.0,
+                100.0,
+                "0..=100",
+            ),
+            r(
+                "physics.recycling.spent_fraction_of_peak",
+                p.recycling.spent_fraction_of_peak,
+                0.0,
+                1.0,
+                "0..=1",
+            ),
+            r(
+                "physics.recycling.max_age_s",
+                p.recycling.max_age_s,
+                1e-3,
+                1e9,
+                "> 0 s",
+            ),
+            Check::new(
+                "physics.sph.smoothing_radii",
+                super::check::finite_in(p.sph.smoothing_radii, 1e-3, 100.0)
+                    && (!p.sph.enabled
+                        || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m),
+                "> 0, with smoothing_radii * radius_m <= domain_size_m / 2",
+                p.sph.smoothing_radii,
+            ),
+            r(
+                "physics.sph.sound_speed_mps",
+                p.sph.sound_speed_mps,
+                1e-6,
+                1e3,
+                "> 0 m/s",
+            ),
+            r(
+                "physics.sph.viscosity_m2ps",
+                p.sph.viscosity_m2ps,
+                0.0,
+                1e7,
+                ">= 0 m²/s",
+            ),
+            r(
+                "physics.wind.speed_mps",
+                p.wind.speed_mps,
+                0.0,
+                200.0,
+                "0..=200 m/s",
+            ),
+            Check::new(
+                "physics.wind.direction_deg",
+                p.wind.direction_deg.is_finite(),
+                "a finite angle",
+                p.wind.direction_deg,
+            ),
+            r(
+                "physics.wind.shear_per_km",
+                p.wind.shear_per_km,
+                -1.0,
+                10.0,
+                "-1..=10 1/km",
+            ),
+            r(
+                "physics.substeps.max_buoyancy_phase",
+                p.substeps.max_buoyancy_phase,
+                1e-6,
+                1.0,
+                "(0, 1]",
+            ),
+            r(
+                "physics.substeps.max_rise_m",
+                p.substeps.max_rise_m,
+                1e-3,
+                1e5,
+                "> 0 m",
+            ),
+            r(
+                "physics.substeps.sph_courant",
+                p.substeps.sph_courant,
+                1e-6,
+                1.0,
+                "(0, 1]",
+            ),
+            Check::new(
+                "physics.substeps.max_per_frame",
+                (1..=1_000_000).contains(&p.substeps.max_per_frame),
+                "1..=1000000",
+                p.substeps.max_per_frame as f64,
+            ),
+        ]
+    }
+}
+
 /// The simulator's parameters (scene table `[physics]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -209,7 +385,7 @@ impl Default for Wind {
 #[serde(deny_unknown_fields, default)]
 pub struct Substeps {
     /// Largest `N Δt_sub` (buoyancy oscillation phase per sub-step). Domain
-    /// (0, 1]. Default 0.5 (physics.md section 4).
+    /// (0, 1]. Default 0.5 (stable over `tests/stability.rs`'s matrix).
     pub max_buoyancy_phase: f64,
     /// Largest vertical travel of any parcel per sub-step, m (> 0), so that
     /// the environment is sampled finely. Default 25.

@@ -1,4 +1,4 @@
-//! Physical constants, SI units (see `shared/design/physics.md` section 1).
+//! Physical constants, SI units.
 
 /// Gravitational acceleration, m/s².
 pub const G: f64 = 9.80665;

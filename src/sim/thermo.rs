@@ -41,7 +41,7 @@ pub fn latent_heat_at(t_k: f64) -> f64 {
 /// (2020), Eq. 13, `e_s = e_0 (T_0/T)^((c_pl - c_pv)/R_v)
 /// exp(L_0/(R_v T_0) - L(T)/(R_v T))`, the form MetPy uses since 1.6.
 ///
-/// physics.md names Bolton (1980); Ambaum's form is exact for a
+/// The usual choice is Bolton (1980); Ambaum's form is exact for a
 /// temperature-dependent `L_v`, and Bolton's differs from it by up to 0.3 %
 /// at 40 °C, which moved hot, humid LCLs by up to 18 m against MetPy 1.7.
 #[inline]
@@ -62,7 +62,7 @@ fn dln_es_dt(t_k: f64) -> f64 {
 ///
 /// Where `e_s` approaches `p` (very hot or very low pressure) the mixing
 /// ratio is unbounded; it is capped at 1 kg/kg so that every state stays
-/// finite (physics.md section 4).
+/// finite (the stability matrix, `tests/stability.rs`, relies on it).
 #[inline]
 pub fn saturation_mixing_ratio(t_k: f64, p_pa: f64) -> f64 {
     let es = saturation_vapour_pressure(t_k);

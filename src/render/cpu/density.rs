@@ -1,5 +1,5 @@
 //! Cloud density inside the height band, from P and the cloud map
-//! (rendering.md section 2).
+//! (README, "The renderer").
 
 use glam::Vec3;
 
@@ -116,10 +116,11 @@ pub fn detail_noise(p: Vec3, scale_m: f32) -> f32 {
 /// because this ramp is the same everywhere.
 pub const BASE_RAMP: f32 = 0.04;
 
-/// The 2D footprint of the cloud at map coordinate `uv`: `(shape, η_top)`,
-/// where shape is the cloud-map cell remapped by coverage and P's coverage,
-/// and `η_top` the local cloud top (taller with the parcel height `h` and in
-/// the cell's middle: rounded tops). `(0, 0)` where there is no cloud.
+/// The 2D footprint of the cloud at map coordinate `(u, v)`:
+/// `(shape, η_top, fill)`, where shape is the cloud-map cell remapped by
+/// coverage and P's coverage, `η_top` the local cloud top (taller with the
+/// parcel height `h` and in the cell's middle: rounded tops), and fill P's
+/// fill density. `(0, 0, 0)` where there is no cloud.
 #[inline]
 pub fn footprint(u: f32, v: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f32) {
     let [c, h, fill] = f.p.sample(u, v);

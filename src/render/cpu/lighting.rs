@@ -1,6 +1,6 @@
 //! Light: phase functions, sun transmittance by a secondary march,
 //! multiple-scattering octaves and the energy-conserving step
-//! (rendering.md section 3).
+//! (README, "The renderer").
 
 use std::f32::consts::PI;
 
@@ -21,9 +21,12 @@ pub fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
     0.75 * phase_hg(cos_theta, 0.8 * eccentricity) + 0.25 * phase_hg(cos_theta, -0.3 * eccentricity)
 }
 
+/// The longest shadow ray toward the sun, m (`SHADOW_RAY_M` in WGSL).
+pub const SHADOW_RAY_M: f32 = 2000.0;
+
 /// Optical depth (dimensionless) from `p` toward the sun through the band,
 /// by `steps` samples with growing step lengths (1, 2, 3, ... parts) over
-/// at most 2 km. The detail noise is left out of shadow rays: it changes
+/// at most [`SHADOW_RAY_M`]. The detail noise is left out of shadow rays: it changes
 /// the light little and would triple their cost.
 #[inline]
 pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
@@ -37,9 +40,9 @@ pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &Den
     let to_top = if sun_dir.y > 1e-3 {
         (d.band_top_m - p.y).max(0.0) / sun_dir.y
     } else {
-        2000.0
+        SHADOW_RAY_M
     };
-    let length = to_top.min(2000.0);
+    let length = to_top.min(SHADOW_RAY_M);
     let parts = (steps * (steps + 1) / 2) as f32;
     let mut t = 0.0;
     let mut tau = 0.0;

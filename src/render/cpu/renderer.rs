@@ -3,13 +3,12 @@
 
 use glam::Vec3;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use super::camera::Camera;
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
 use super::sky::{sky_radiance, sun_color, sun_direction, sun_disk};
-use crate::render::terrain::{Heightfield, TerrainConfig};
+use crate::render::terrain::Heightfield;
 
 /// Quality and look (scene table `[render]` keys that are not camera,
 /// sun or cloud map).
@@ -230,6 +229,22 @@ pub fn render_linear(width: u32, height: u32, fr: &Frame) -> Vec<Vec3> {
     out
 }
 
+/// A `width x height` image of `samples x samples` rays per pixel
+/// (a box filter over a finer image), as sRGB8: the reference that TSAA's
+/// jittered frames converge to, for the benchmark's error and the tests.
+pub fn supersampled_srgb8(width: u32, height: u32, samples: u32, fr: &Frame) -> Vec<u8> {
+    let s = samples.max(1);
+    let fine = render_linear(width * s, height * s, fr);
+    let mut out = vec![Vec3::ZERO; (width * height) as usize];
+    for y in 0..height * s {
+        for x in 0..width * s {
+            out[((y / s) * width + x / s) as usize] +=
+                fine[(y * width * s + x) as usize] / (s * s) as f32;
+        }
+    }
+    to_srgb8(&out, fr.quality.exposure)
+}
+
 /// The tone map, `1 - e^{-x·exposure}`: linear radiance to display `0..1`.
 /// The images and the quality report both use it.
 #[inline]
@@ -252,114 +267,4 @@ pub fn to_srgb8(linear: &[Vec3], exposure: f32) -> Vec<u8> {
         .iter()
         .flat_map(|c| [enc(c.x), enc(c.y), enc(c.z)])
         .collect()
-}
-
-/// The `[render]` scene table.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RenderSettings {
-    /// Image width, pixels (1..=8192). Default 640.
-    pub width: u32,
-    /// Image height, pixels (1..=8192). Default 480.
-    pub height: u32,
-    /// Camera position `[x east, y up, z north]`, m. Default `[0, 100, 0]`.
-    pub camera_position_m: [f32; 3],
-    /// Camera heading, degrees clockwise from north. Default 20.
-    pub camera_yaw_deg: f32,
-    /// Camera pitch above the horizon, degrees (-89..=89). Default 12.
-    pub camera_pitch_deg: f32,
-    /// Vertical field of view, degrees (1..=170). Default 60.
-    pub fov_deg: f32,
-    /// Sun elevation above the horizon, degrees (-10..=90). Default 40.
-    pub sun_elevation_deg: f32,
-    /// Sun azimuth, degrees clockwise from north. Default 135.
-    pub sun_azimuth_deg: f32,
-    /// Fraction of each P-covered cloud-map cell that becomes cloud, 0..=1.
-    /// Default 0.75.
-    pub coverage: f32,
-    /// Extinction of the densest cloud, 1/m (> 0). Default 0.04.
-    pub extinction_per_m: f32,
-    /// Strength of the 3D detail noise eroding edges, 0..=1 (0: off, not
-    /// evaluated). Default 0.5.
-    pub detail_strength: f32,
-    /// Size of the detail noise's features, m (> 0). Default 250.
-    pub detail_scale_m: f32,
-    /// Primary march steps (1..=4096). Default 48 (chosen from
-    /// `cumulus render --quality-report`, see README).
-    pub steps: u32,
-    /// Shadow march steps toward the sun (0..=64; 0 = off). Default 6.
-    pub shadow_steps: u32,
-    /// Multiple-scattering octaves beyond the first (0..=3). Default 2.
-    pub octaves: u32,
-    /// Aerial-perspective distance, m (> 0). Default 25000.
-    pub haze_distance_m: f32,
-    /// Longest ray, m (> 0). Default 40000.
-    pub max_distance_m: f32,
-    /// Exposure before tone mapping (> 0). Default 1.2.
-    pub exposure: f32,
-    /// Physics seconds simulated before the picture (>= 0). Default 2400.
-    pub time_s: f64,
-    /// Temporal anti-aliasing on the GPU (the CPU reference never jitters).
-    /// Off: no jitter, no history textures, no TSAA pass. Default true.
-    pub tsaa: bool,
-    /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
-    pub tsaa_blend: f32,
-    /// The cloud map (`[render.cloud_map]`).
-    pub cloud_map: crate::render::cloud_map::CloudMapConfig,
-    /// The terrain (`[render.terrain]`), off by default.
-    pub terrain: TerrainConfig,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            width: 640,
-            height: 480,
-            camera_position_m: [0.0, 100.0, 0.0],
-            camera_yaw_deg: 20.0,
-            camera_pitch_deg: 12.0,
-            fov_deg: 60.0,
-            sun_elevation_deg: 40.0,
-            sun_azimuth_deg: 135.0,
-            coverage: 0.75,
-            extinction_per_m: 0.04,
-            detail_strength: 0.5,
-            detail_scale_m: 250.0,
-            steps: 48,
-            shadow_steps: 6,
-            octaves: 2,
-            haze_distance_m: 25_000.0,
-            max_distance_m: 40_000.0,
-            exposure: 1.2,
-            time_s: 2400.0,
-            tsaa: true,
-            tsaa_blend: 0.1,
-            cloud_map: Default::default(),
-            terrain: TerrainConfig::default(),
-        }
-    }
-}
-
-impl RenderSettings {
-    /// The camera.
-    pub fn camera(&self) -> Camera {
-        Camera {
-            position_m: Vec3::from_array(self.camera_position_m),
-            yaw_deg: self.camera_yaw_deg,
-            pitch_deg: self.camera_pitch_deg,
-            fov_deg: self.fov_deg,
-        }
-    }
-
-    /// The quality knobs.
-    pub fn quality(&self) -> Quality {
-        Quality {
-            steps: self.steps,
-            shadow_steps: self.shadow_steps,
-            octaves: self.octaves,
-            haze_distance_m: self.haze_distance_m,
-            max_distance_m: self.max_distance_m,
-            exposure: self.exposure,
-        }
-    }
 }

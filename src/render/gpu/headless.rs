@@ -2,11 +2,14 @@
 //! the GPU tests and the frame timings.
 
 use super::context::{GpuContext, GpuError};
-use super::renderer::{CloudRenderer, GpuSettings};
+use super::renderer::CloudRenderer;
+use super::settings::GpuSettings;
 use super::textures;
 use super::timer::{FrameTimes, time_frames};
+use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::camera::Camera;
-use crate::render::prepare::Prepared;
+use crate::render::terrain::Heightfield;
+use crate::sim::ProjectedField;
 
 /// The offscreen target's format: 8-bit sRGB, the CPU `to_srgb8`'s encoding.
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -30,13 +33,15 @@ pub struct Headless {
 }
 
 impl Headless {
-    /// A `width x height` offscreen renderer of `prepared` with `settings`.
+    /// A `width x height` offscreen renderer of P (`field`), the cloud
+    /// map and the terrain with `settings`.
     pub fn new(
         ctx: &GpuContext,
-        prepared: &Prepared,
+        field: &ProjectedField,
+        cloud_map: &CloudMap,
+        terrain: Option<&Heightfield>,
         settings: &GpuSettings,
-        width: u32,
-        height: u32,
+        (width, height): (u32, u32),
     ) -> Result<Self, GpuError> {
         ctx.checked(|| {
             let mut renderer = CloudRenderer::new(
@@ -44,10 +49,10 @@ impl Headless {
                 &ctx.queue,
                 TARGET_FORMAT,
                 settings,
-                &prepared.cloud_map,
-                prepared.terrain.as_ref(),
+                cloud_map,
+                terrain,
             );
-            renderer.update_field(&ctx.queue, &prepared.field);
+            renderer.update_field(&ctx.queue, field);
             renderer.resize(width, height);
             let target = target(ctx, width, height);
             Self { renderer, target }

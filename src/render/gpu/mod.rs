@@ -2,18 +2,24 @@
 //! library to embed in a wgpu application ([`CloudRenderer`]), plus a
 //! headless path for `cumulus render --backend gpu` and the tests.
 
+pub mod baseline;
+mod bind;
+mod cloud_pass;
+mod composite_pass;
+pub mod context;
+pub mod headless;
+mod inputs;
 pub mod renderer;
+pub mod settings;
 pub mod shaders;
+mod terrain_pass;
 pub mod textures;
 pub mod timer;
 pub mod tsaa;
 pub mod uniforms;
 
-pub use renderer::{CloudRenderer, GpuSettings, RenderError};
-pub use tsaa::TsaaSettings;
-pub mod baseline;
-pub mod context;
-pub mod headless;
-
 pub use context::{GpuContext, GpuError};
 pub use headless::Headless;
+pub use renderer::{CloudRenderer, RenderError};
+pub use settings::GpuSettings;
+pub use tsaa::TsaaSettings;

@@ -86,89 +86,39 @@ pub fn terrain_pass() -> String {
     format!("{CLOUDS}\n{TERRAIN}")
 }
 
+/// The per-parcel baseline's source (`cumulus bench` only).
+pub fn baseline_pass() -> String {
+    format!("{CLOUDS}\n{COMPOSITE}\n{}", super::baseline::BASELINE)
+}
+
+/// Every variant's source: the cloud pass with and without depth and
+/// TSAA, the composite pass over each background, TSAA, terrain and the
+/// baseline.
+pub fn all_variants() -> Vec<String> {
+    let mut sources = vec![tsaa_pass(), terrain_pass(), baseline_pass()];
+    for depth in [false, true] {
+        for tsaa in [false, true] {
+            sources.push(cloud_pass(depth, tsaa));
+        }
+    }
+    for b in [
+        Background::Sky,
+        Background::Terrain,
+        Background::ExternalDepth,
+    ] {
+        sources.push(composite_pass(b));
+    }
+    sources
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Every CPU reference function the GPU evaluates has a WGSL twin of the
-    /// same name (the parity tests then compare what they compute).
-    #[test]
-    fn every_cpu_function_has_a_wgsl_twin() {
-        let all = format!("{CLOUDS}{COMPOSITE}{TSAA}{TERRAIN}");
-        for name in [
-            "height_fraction",
-            "band_segment",
-            "hash3",
-            "value_noise3",
-            "detail_noise",
-            "footprint",
-            "density_at",
-            "phase_hg",
-            "phase_dual",
-            "sun_optical_depth",
-            "sun_transmittance",
-            "sun_scattering",
-            "integrate_step",
-            "sun_color",
-            "sky_radiance",
-            "sun_disk",
-            "pixel_dither",
-            "tone_map",
-            "march_ray",
-            "terrain_radiance",
-            "cloud_shadow",
-            "height_at",
-            "normal_at",
-            "coarse_empty",
-        ] {
-            assert!(all.contains(&format!("fn {name}(")), "no WGSL fn {name}");
-        }
-        // And the constants they share.
-        use crate::render::cpu::{density, renderer, sky};
-        for (name, value) in [
-            ("BASE_RAMP", density::BASE_RAMP),
-            ("ALBEDO", renderer::ALBEDO),
-            ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE),
-            ("SUN_DISK_COS", sky::SUN_DISK_COS),
-        ] {
-            let line = CLOUDS
-                .lines()
-                .find(|l| l.starts_with(&format!("const {name}:")))
-                .unwrap_or_else(|| panic!("no WGSL const {name}"));
-            let v: f32 = line
-                .rsplit('=')
-                .next()
-                .and_then(|v| v.trim().trim_end_matches(';').parse().ok())
-                .unwrap_or_else(|| panic!("{line}"));
-            assert_eq!(v, value, "{name}");
-        }
-        assert!(CLOUDS.contains(&format!("const REFINE: u32 = {}u;", renderer::REFINE)));
-    }
-
     /// Every variant parses and validates with naga (no GPU needed).
     #[test]
     fn every_variant_validates() {
-        let mut sources = vec![
-            tsaa_pass(),
-            terrain_pass(),
-            format!(
-                "{CLOUDS}\n{COMPOSITE}\n{}",
-                super::super::baseline::BASELINE
-            ),
-        ];
-        for depth in [false, true] {
-            for tsaa in [false, true] {
-                sources.push(cloud_pass(depth, tsaa));
-            }
-        }
-        for b in [
-            Background::Sky,
-            Background::Terrain,
-            Background::ExternalDepth,
-        ] {
-            sources.push(composite_pass(b));
-        }
-        for src in sources {
+        for src in all_variants() {
             let module = naga::front::wgsl::parse_str(&src)
                 .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
             naga::valid::Validator::new(

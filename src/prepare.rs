@@ -1,12 +1,18 @@
 //! From a scene to what a frame needs: simulate, project P, generate the
-//! cloud map (and terrain), place parcels on the map's cells.
+//! cloud map (and terrain), place parcels on the map's cells, and turn the
+//! scene's `[render]` section into the renderers' settings. This is the
+//! one place that sees the scene, the simulation and the renderers
+//! together; the renderers see the simulation only through P.
+
+use glam::DVec2;
 
 use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::density::{DensityParams, Fields};
-use crate::render::cpu::renderer::{Frame, Quality, RenderSettings};
-use crate::render::gpu::{GpuSettings, TsaaSettings};
+use crate::render::cpu::renderer::{Frame, Quality};
+use crate::render::gpu::baseline::Sphere;
+use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless, TsaaSettings};
 use crate::render::terrain::Heightfield;
-use crate::scene::{Scene, SceneError};
+use crate::scene::{RenderSettings, Scene, SceneError};
 use crate::sim::{Band, Parcels, ProjectedField, Simulation};
 
 /// A scene's textures at one moment.
@@ -14,6 +20,8 @@ pub struct Prepared {
     pub field: ProjectedField,
     /// The parcels P was projected from (for the per-parcel baseline).
     pub parcels: Parcels,
+    /// The projection's fill scale (`physics.fill_full_condensed_fraction`).
+    pub fill_full_condensed_fraction: f64,
     pub cloud_map: CloudMap,
     pub terrain: Option<Heightfield>,
     pub band: Band,
@@ -31,26 +39,17 @@ impl Prepared {
         let cloud_map = CloudMap::generate(&r.cloud_map);
         let terrain = r.terrain.enabled.then(|| Heightfield::generate(&r.terrain));
         let l = scene.physics.domain_size_m;
-        let sites = cloud_map
-            .cell_centres(64)
-            .into_iter()
-            .map(|(u, v)| glam::DVec2::new(u as f64 * l, v as f64 * l))
-            .collect();
         let mut sim = Simulation::new(scene.physics.clone(), atm);
-        sim.set_spawn_sites(sites);
+        sim.set_spawn_sites(spawn_sites(&cloud_map, l));
         for _ in 0..Self::frames(scene) {
             sim.step();
             progress();
         }
         let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
-        field.project(
-            sim.parcels(),
-            l,
-            band,
-            scene.physics.fill_full_condensed_fraction,
-        );
+        sim.project_into(&mut field, band);
         Ok(Self {
             parcels: sim.parcels().clone(),
+            fill_full_condensed_fraction: scene.physics.fill_full_condensed_fraction,
             field,
             cloud_map,
             terrain,
@@ -69,7 +68,25 @@ impl Prepared {
         gpu_settings(r, self.band, self.map_extent_m, quality)
     }
 
-    /// The frame for `settings` with `quality`.
+    /// A `width x height` offscreen GPU renderer of these fields.
+    pub fn headless(
+        &self,
+        ctx: &GpuContext,
+        settings: &GpuSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<Headless, GpuError> {
+        Headless::new(
+            ctx,
+            &self.field,
+            &self.cloud_map,
+            self.terrain.as_ref(),
+            settings,
+            (width, height),
+        )
+    }
+
+    /// The CPU frame for `settings` with `quality`.
     pub fn frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
         Frame {
             camera: r.camera(),
@@ -84,6 +101,21 @@ impl Prepared {
             terrain: self.terrain.as_ref(),
         }
     }
+
+    /// The cloudy parcels as the per-parcel baseline's spheres.
+    pub fn spheres(&self) -> Vec<Sphere> {
+        spheres(&self.parcels, self.fill_full_condensed_fraction)
+    }
+}
+
+/// Where parcels are born: the centres of the cloud map's cells (up to 64)
+/// in the physics domain of side `extent_m`.
+pub fn spawn_sites(cloud_map: &CloudMap, extent_m: f64) -> Vec<DVec2> {
+    cloud_map
+        .cell_centres(64)
+        .into_iter()
+        .map(|(u, v)| DVec2::new(u as f64 * extent_m, v as f64 * extent_m))
+        .collect()
 }
 
 /// The density's parameters for `[render]` settings `r`, a cloud band and
@@ -118,4 +150,33 @@ pub fn gpu_settings(
         }),
         debug_sample_count: false,
     }
+}
+
+/// The cloudy, released parcels as spheres in the world frame (the
+/// physics' `(x, y, z)` is the world's `(x, z, y)`), with the fill the
+/// projection gives them. The spheres are not tiled: the domain is drawn
+/// once.
+pub fn spheres(parcels: &Parcels, fill_full_condensed_fraction: f64) -> Vec<Sphere> {
+    let full = fill_full_condensed_fraction.max(1e-12);
+    (0..parcels.len())
+        .filter(|&i| parcels.diag[i].qc > 0.0 && parcels.life[i].released())
+        .map(|i| {
+            let p = parcels.pos[i];
+            let qt = parcels.qt[i];
+            let fill = if qt > 0.0 {
+                (parcels.diag[i].qc / qt / full).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            Sphere {
+                centre_radius: [
+                    p.x as f32,
+                    p.z as f32,
+                    p.y as f32,
+                    parcels.life[i].radius_m as f32,
+                ],
+                fill: [fill as f32, 0.0, 0.0, 0.0],
+            }
+        })
+        .collect()
 }

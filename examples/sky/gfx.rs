@@ -1,0 +1,149 @@
+//! The GPU side of the demo: the window's surface, the device (a
+//! `GpuContext` on the adapter that can present to it), the cloud renderer,
+//! egui's renderer and the timestamp queries.
+
+use std::sync::Arc;
+
+use anyhow::{Context, Result, anyhow};
+use cumulus::prepare::gpu_settings;
+use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings};
+use winit::window::Window;
+
+use crate::world::World;
+
+/// What to install when no adapter can draw to the window.
+const NO_ADAPTER: &str = "Install a Vulkan driver (on Debian/Ubuntu, software Vulkan: `sudo apt-get install mesa-vulkan-drivers`), or use `cumulus render --backend cpu` for still pictures";
+
+/// The GPU side: surface, device, the cloud renderer and egui's renderer.
+pub struct Gfx {
+    pub surface: wgpu::Surface<'static>,
+    pub ctx: GpuContext,
+    pub config: wgpu::SurfaceConfiguration,
+    pub clouds: CloudRenderer,
+    pub egui: egui_wgpu::Renderer,
+    /// Timestamp queries of the renderer's passes (query set, resolve
+    /// buffer, read buffer), when supported.
+    pub timestamps: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
+    pub period_ns: f64,
+    pub description: String,
+}
+
+/// The cloud renderer's settings for the world's scene.
+pub fn settings_of(world: &World) -> GpuSettings {
+    let r = &world.scene.render;
+    gpu_settings(
+        r,
+        world.band,
+        world.scene.physics.domain_size_m,
+        r.quality(),
+    )
+}
+
+impl Gfx {
+    /// Finds an adapter that can present to `window` (`WGPU_BACKEND`
+    /// narrows the search), configures the surface (sRGB when offered) and
+    /// builds the renderers for `world`.
+    pub fn new(window: Arc<Window>, world: &World) -> Result<Self> {
+        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance
+            .create_surface(window.clone())
+            .map_err(|e| anyhow!("no GPU adapter can draw to this window ({e}). {NO_ADAPTER}"))?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: Some(&surface),
+            apply_limit_buckets: false,
+        }))
+        .map_err(|_| anyhow!("no GPU adapter can draw to this window. {NO_ADAPTER}"))?;
+        let ctx = GpuContext::from_adapter(&adapter).context("requesting a device")?;
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
+        let caps = surface.get_capabilities(&adapter);
+        if let Some(f) = caps.formats.iter().find(|f| f.is_srgb()) {
+            config.format = *f;
+        }
+        if caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
+            config.usage |= wgpu::TextureUsages::COPY_SRC;
+        }
+        if size.width > 0 && size.height > 0 {
+            surface.configure(&ctx.device, &config);
+        }
+        let clouds = cloud_renderer(&ctx, config.format, world, (size.width, size.height));
+        let timestamps = ctx.timestamps.then(|| timestamp_queries(&ctx.device));
+        let egui = egui_wgpu::Renderer::new(
+            &ctx.device,
+            config.format,
+            egui_wgpu::RendererOptions::default(),
+        );
+        let info = adapter.get_info();
+        Ok(Self {
+            period_ns: ctx.queue.get_timestamp_period() as f64,
+            surface,
+            ctx,
+            config,
+            clouds,
+            egui,
+            timestamps,
+            description: format!("{} ({:?})", info.name, info.backend),
+        })
+    }
+
+    /// A new cloud renderer for a newly loaded world, at the same size.
+    pub fn rebuild_clouds(&mut self, world: &World) {
+        let size = self.clouds.size();
+        self.clouds = cloud_renderer(&self.ctx, self.config.format, world, size);
+    }
+}
+
+fn cloud_renderer(
+    ctx: &GpuContext,
+    format: wgpu::TextureFormat,
+    world: &World,
+    (width, height): (u32, u32),
+) -> CloudRenderer {
+    let mut clouds = CloudRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        format,
+        &settings_of(world),
+        &world.cloud_map,
+        world.terrain.as_ref(),
+    );
+    clouds.update_field(&ctx.queue, &world.field);
+    clouds.resize(width, height);
+    clouds
+}
+
+/// Eight timestamp queries (two per pass) and their resolve and read
+/// buffers.
+fn timestamp_queries(device: &wgpu::Device) -> (wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer) {
+    let q = device.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("sky.timestamps"),
+        ty: wgpu::QueryType::Timestamp,
+        count: 8,
+    });
+    let buf = |label, usage| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: 64,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    (
+        q,
+        buf(
+            "sky.timestamps.resolve",
+            wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        ),
+        buf(
+            "sky.timestamps.read",
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        ),
+    )
+}

@@ -1,0 +1,102 @@
+//! `cumulus bench`: the GPU frame benchmarks.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+
+use crate::{gpu_context, load_scene};
+
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Scene every configuration starts from.
+    #[arg(long, default_value = "scenes/fair_weather.toml")]
+    scene: PathBuf,
+    /// Output directory (bench.csv, bench.json, physics_in_frame.csv,
+    /// render_error.csv and the plots).
+    #[arg(long)]
+    out: PathBuf,
+    /// Tiny images, 3 frames, 1 warm-up: every configuration runs, fast
+    /// enough for CI on software Vulkan.
+    #[arg(long)]
+    quick: bool,
+    /// Timed frames per configuration (default 30; 3 with --quick).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    frames: Option<u32>,
+    /// Warm-up frames per configuration (default 5; 1 with --quick).
+    #[arg(long)]
+    warmup: Option<u32>,
+    /// Skip a per-parcel configuration predicted to take longer than this
+    /// per frame, s (default 20; 2 with --quick).
+    #[arg(long)]
+    max_frame_s: Option<f64>,
+}
+
+pub fn run(a: BenchArgs) -> Result<()> {
+    use cumulus::report::gpu_bench::{self, BenchOptions};
+    let mut scene = load_scene(&a.scene)?;
+    if a.quick {
+        scene.render.time_s = scene.render.time_s.min(600.0);
+    }
+    let ctx = gpu_context().context("cumulus bench needs a GPU adapter")?;
+    eprintln!("device: {}", ctx.describe());
+    let o = BenchOptions {
+        quick: a.quick,
+        frames: a.frames.unwrap_or(if a.quick { 3 } else { 30 }),
+        warmup: a.warmup.unwrap_or(if a.quick { 1 } else { 5 }),
+        max_frame_s: a.max_frame_s.unwrap_or(if a.quick { 2.0 } else { 20.0 }),
+    };
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    let report = gpu_bench::run(&ctx, &scene, &o, |line| eprintln!("{line}"))?;
+    gpu_bench::write(&report, &a.out)?;
+    println!(
+        "{:<11} {:<10} {:>9} {:>8} {:>7} {:>9} {:>9} {:>10} {:>10} {:>6}",
+        "group",
+        "renderer",
+        "size",
+        "coverage",
+        "parcels",
+        "features",
+        "P_covered",
+        "median_ms",
+        "p95_ms",
+        "timing"
+    );
+    for r in &report.rows {
+        let features = format!(
+            "{}{}s{}o{}{}",
+            if r.tsaa { "T" } else { "-" },
+            if r.terrain { "G" } else { "-" },
+            r.shadow_steps,
+            r.octaves,
+            if r.detail { "D" } else { "-" }
+        );
+        println!(
+            "{:<11} {:<10} {:>9} {:>8} {:>7} {:>9} {:>9.2} {:>10.3} {:>10.3} {:>6}",
+            r.group,
+            r.renderer,
+            format!("{}x{}", r.width, r.height),
+            r.coverage,
+            r.parcels,
+            features,
+            r.p_covered,
+            r.median_ms,
+            r.p95_ms,
+            r.timing
+        );
+    }
+    for n in [12, 85] {
+        if let Some(x) = report.ratio_at(n) {
+            println!("per-parcel / cloud-map frame time at {n} parcels: {x:.1}x");
+        }
+    }
+    println!("physics + projection + upload against the frame:");
+    for p in &report.physics {
+        println!(
+            "  {:>6} parcels: {:.3} + {:.3} + {:.3} ms = {:.2} % of a {:.2} ms frame",
+            p.parcels, p.physics_ms, p.projection_ms, p.upload_ms, p.share_pct, p.frame_ms
+        );
+    }
+    println!("wrote {}", a.out.display());
+    Ok(())
+}

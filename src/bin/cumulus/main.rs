@@ -1,0 +1,148 @@
+//! `cumulus`: the command line, one module per command (`simulate.rs`,
+//! `profile.rs`, `convergence.rs`, `render.rs`, `bench.rs`; `scene check`
+//! is here). Units are in every flag's name and help text. Errors leave
+//! through `anyhow` with the file, line or field. This is the binary's
+//! edge: the only place that reads the environment (`WGPU_BACKEND`) and
+//! sets exit codes.
+
+mod bench;
+mod convergence;
+mod profile;
+mod render;
+mod simulate;
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use cumulus::scene::Scene;
+
+#[derive(Parser)]
+#[command(
+    name = "cumulus",
+    version,
+    about = "Physics-driven cumulus clouds (Goswami, STAG 2019): parcel simulator and tools"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a scene and write the parcel curves (paper's Fig. 5) as CSV.
+    Simulate(simulate::SimulateArgs),
+    /// Lift the sounding's lowest air without mixing (like MetPy's
+    /// parcel_profile): print its LCL, write one row per level.
+    Profile(profile::ProfileArgs),
+    /// Error against run time: run a scene at steps from 0.1 s to 600 s
+    /// against a fine reference; write convergence.csv and convergence.png.
+    Convergence(convergence::ConvergenceArgs),
+    /// Simulate a scene, then render one sky image (PNG) of its clouds.
+    Render(render::RenderArgs),
+    /// GPU frame benchmarks: resolution, coverage, parcel count (cloud map
+    /// against a per-parcel baseline), features, the physics' share of the
+    /// frame, and render error against GPU time. Writes CSV, JSON and PNGs.
+    Bench(bench::BenchArgs),
+    /// Scene files.
+    Scene {
+        #[command(subcommand)]
+        command: SceneCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Validate a scene (and its sounding); report errors with file, line and key.
+    Check {
+        /// Scene TOML file.
+        file: PathBuf,
+    },
+}
+
+fn main() {
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Simulate(a) => simulate::run(a),
+        Command::Profile(a) => profile::run(a),
+        Command::Convergence(a) => convergence::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Scene {
+            command: SceneCommand::Check { file },
+        } => {
+            let scene = Scene::load(&file)?;
+            let atm = scene.atmosphere(None)?;
+            let band = scene.band(&atm);
+            println!(
+                "{}: ok ({}; {} parcels, dt {} s, cloud band {:.0}-{:.0} m)",
+                file.display(),
+                if scene.name.is_empty() {
+                    "unnamed"
+                } else {
+                    &scene.name
+                },
+                scene.physics.parcels,
+                scene.physics.dt_s,
+                band.bottom_m,
+                band.top_m
+            );
+            Ok(())
+        }
+    }
+}
+
+fn progress_bar(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(
+        Some(len),
+        if std::io::stderr().is_terminal() {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        },
+    );
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_owned());
+    bar
+}
+
+fn finite_positive(name: &str, v: f64) -> Result<()> {
+    if !(v.is_finite() && v > 0.0) {
+        bail!("{name} is {v}, expected a positive number of seconds");
+    }
+    Ok(())
+}
+
+fn load_scene(path: &Path) -> Result<Scene> {
+    Ok(Scene::load(path)?)
+}
+
+/// The scene with the flags that override its keys applied, validated
+/// again (a flag's bad value is reported like a bad key, naming `flags`).
+fn with_overrides(mut scene: Scene, flags: &str, apply: impl FnOnce(&mut Scene)) -> Result<Scene> {
+    apply(&mut scene);
+    scene
+        .validate()
+        .with_context(|| format!("after applying {flags}"))?;
+    Ok(scene)
+}
+
+/// The GPU, from `WGPU_BACKEND` when set (the binary's edge reads the
+/// environment, the library does not).
+fn gpu_context() -> Result<cumulus::render::gpu::GpuContext, cumulus::render::gpu::GpuError> {
+    let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+    cumulus::render::gpu::GpuContext::new(backends)
+}

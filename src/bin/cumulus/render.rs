@@ -1,0 +1,233 @@
+//! `cumulus render`: simulate a scene, then render one picture on the GPU
+//! or with the CPU reference (and the render-quality report).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+
+use cumulus::io::write_png_atomically;
+use cumulus::prepare::Prepared;
+use cumulus::render::gpu::GpuContext;
+use cumulus::scene::Scene;
+
+use crate::{gpu_context, load_scene, progress_bar, with_overrides};
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Scene TOML file.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Output PNG (written atomically).
+    #[arg(long, required_unless_present = "quality_report")]
+    out: Option<PathBuf>,
+    /// Also write the error-against-cost report (render_quality.csv/.png)
+    /// into this directory: step counts from 8 to 256 against a 2048-step
+    /// reference, at up to 320x240.
+    #[arg(long)]
+    quality_report: Option<PathBuf>,
+    /// Image width in pixels (overrides render.width).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (overrides render.height).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Simulated seconds before the picture (overrides render.time_s).
+    #[arg(long)]
+    time_s: Option<f64>,
+    /// Primary ray-march steps (overrides render.steps).
+    #[arg(long)]
+    steps: Option<u32>,
+    /// auto: a hardware GPU when wgpu finds one, else the CPU reference;
+    /// cpu; gpu (any adapter wgpu finds, software Vulkan included).
+    /// WGPU_BACKEND (vulkan, gl, metal, dx12) narrows the search.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    backend: Backend,
+    /// GPU frames rendered from the still camera before the picture is
+    /// taken, so TSAA has converged (default: 32 with render.tsaa, else 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    frames: Option<u32>,
+    /// GPU: also time this many frames (after 10 warm-up frames) and print
+    /// the median and 95th percentile, from timestamp queries when the
+    /// adapter has them, else CPU wall time (labelled).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    time_frames: Option<u32>,
+}
+
+/// Which renderer draws the image.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    Auto,
+    Cpu,
+    Gpu,
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    use cumulus::render::cpu::renderer::{render_linear, to_srgb8};
+    use cumulus::report::render_quality;
+
+    let flags = "--width/--height/--time-s/--steps";
+    let scene = with_overrides(load_scene(&a.scene)?, flags, |s| {
+        let r = &mut s.render;
+        if let Some(w) = a.width {
+            r.width = w;
+        }
+        if let Some(h) = a.height {
+            r.height = h;
+        }
+        if let Some(t) = a.time_s {
+            r.time_s = t;
+        }
+        if let Some(steps) = a.steps {
+            r.steps = steps;
+        }
+    })?;
+    let gpu = match a.backend {
+        Backend::Cpu => None,
+        Backend::Gpu => Some(gpu_context().context("--backend gpu")?),
+        Backend::Auto => match gpu_context() {
+            Ok(c) if c.adapter_info.device_type != wgpu::DeviceType::Cpu => Some(c),
+            Ok(c) => {
+                eprintln!(
+                    "backend: cpu (the only GPU adapter is software, {}; --backend gpu uses it)",
+                    c.adapter_info.name
+                );
+                None
+            }
+            Err(e) => {
+                eprintln!("backend: cpu ({e})");
+                None
+            }
+        },
+    };
+    if gpu.is_none() && a.time_frames.is_some() {
+        bail!("--time-frames needs the GPU backend (--backend gpu)");
+    }
+    let bar = progress_bar(Prepared::frames(&scene), "simulating");
+    let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
+    bar.finish_and_clear();
+    let r = &scene.render;
+    let frame = prepared.frame(r, r.quality());
+    if let Some(dir) = &a.quality_report {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+        let (w, h) = (r.width.min(320), r.height.min(240));
+        let bar = progress_bar(render_quality::STEPS.len() as u64 + 1, "rendering");
+        let report = render_quality::measure(&frame, w, h, &render_quality::STEPS, || bar.inc(1));
+        bar.finish_and_clear();
+        render_quality::write(&report, dir)?;
+        println!(
+            "reference ({} steps) took {:.2} s at {w}x{h}",
+            render_quality::REFERENCE_STEPS,
+            report.reference_wall_s
+        );
+        println!(
+            "{:>6} {:>9} {:>11} {:>10}",
+            "steps", "wall_s", "mean_error", "max_error"
+        );
+        for row in &report.rows {
+            println!(
+                "{:>6} {:>9.4} {:>11.5} {:>10.4}",
+                row.steps, row.wall_s, row.mean_error, row.max_error
+            );
+        }
+        match report.chosen {
+            Some(i) => println!(
+                "least-cost step count with mean error <= {}: {}",
+                render_quality::TARGET_MEAN_ERROR,
+                report.rows[i].steps
+            ),
+            None => println!(
+                "no step count reached mean error <= {}",
+                render_quality::TARGET_MEAN_ERROR
+            ),
+        }
+        println!(
+            "wrote {0}/render_quality.csv and {0}/render_quality.png",
+            dir.display()
+        );
+    }
+    if let Some(ctx) = &gpu {
+        return render_gpu(ctx, &a, &scene, &prepared);
+    }
+    eprintln!("backend: cpu (the CPU reference renderer)");
+    let Some(out) = &a.out else { return Ok(()) };
+    let start = std::time::Instant::now();
+    let linear = render_linear(r.width, r.height, &frame);
+    let elapsed = start.elapsed();
+    let bytes = to_srgb8(&linear, r.exposure);
+    let img = image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
+    write_png_atomically(out, &img)
+        .with_context(|| format!("{}: cannot write image", out.display()))?;
+    eprintln!(
+        "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        r.width,
+        r.height,
+        elapsed.as_secs_f64(),
+        r.steps,
+        r.shadow_steps,
+        r.octaves,
+        100.0 * prepared.field.covered_fraction(),
+        prepared.band.bottom_m,
+        prepared.band.top_m,
+        out.display()
+    );
+    Ok(())
+}
+
+/// `render` on the GPU: `--frames` frames (TSAA converges), the last one
+/// saved; `--time-frames` times more.
+fn render_gpu(ctx: &GpuContext, a: &RenderArgs, scene: &Scene, prepared: &Prepared) -> Result<()> {
+    let r = &scene.render;
+    eprintln!("backend: gpu ({})", ctx.describe());
+    let settings = prepared.gpu_settings(r, r.quality());
+    let mut hl = prepared.headless(ctx, &settings, r.width, r.height)?;
+    let frames = a.frames.unwrap_or(if r.tsaa { 32 } else { 1 });
+    let start = std::time::Instant::now();
+    hl.render(ctx, &r.camera(), frames)?;
+    let elapsed = start.elapsed();
+    if let Some(out) = &a.out {
+        let bytes = hl.read_rgb8(ctx)?;
+        let img =
+            image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
+        write_png_atomically(out, &img)
+            .with_context(|| format!("{}: cannot write image", out.display()))?;
+        eprintln!(
+            "rendered {}x{}, {frames} frame(s) in {:.2} s ({} steps, {} shadow steps, {} octaves, TSAA {}; passes {}); wrote {}",
+            r.width,
+            r.height,
+            elapsed.as_secs_f64(),
+            r.steps,
+            r.shadow_steps,
+            r.octaves,
+            if r.tsaa { "on" } else { "off" },
+            hl.renderer.last_passes().join(", "),
+            out.display()
+        );
+    }
+    if let Some(n) = a.time_frames {
+        let t = hl.time_frames(ctx, &r.camera(), 10, n)?;
+        let source = if t.gpu {
+            "GPU timestamps"
+        } else {
+            "CPU wall time, submit to idle (no timestamp queries)"
+        };
+        println!(
+            "frame {}x{}: median {:.3} ms, p95 {:.3} ms over {n} frames ({source}; {})",
+            r.width,
+            r.height,
+            t.median(),
+            t.p95(),
+            ctx.describe()
+        );
+        if t.gpu {
+            for (k, pass) in hl.renderer.last_passes().iter().enumerate() {
+                let v: Vec<f64> = t.per_pass.iter().map(|f| f[k]).collect();
+                println!(
+                    "  {pass}: median {:.3} ms",
+                    cumulus::render::gpu::timer::FrameTimes::quantile(&v, 0.5)
+                );
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,108 @@
+//! The `composite` pass: the resolved cloud layer over the sky, the
+//! terrain or the application's own colour (where its depth buffer has
+//! geometry), tone-mapped into the target.
+
+use super::bind::{self, Recorder, UNFILTERABLE};
+use super::inputs::Inputs;
+use super::shaders::{self, Background};
+
+/// The pass's name.
+pub const PASS_COMPOSITE: &str = "composite";
+
+/// One pipeline per background, built on first use.
+#[derive(Default)]
+pub struct CompositePass {
+    pipelines: Vec<(Background, wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+}
+
+impl CompositePass {
+    /// Drops the pipelines (their constants changed).
+    pub fn invalidate(&mut self) {
+        self.pipelines.clear();
+    }
+
+    /// Pipelines built so far.
+    pub fn pipeline_count(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    fn pipeline(
+        &mut self,
+        device: &wgpu::Device,
+        group0: &wgpu::BindGroupLayout,
+        constants: &[(&str, f64)],
+        target_format: wgpu::TextureFormat,
+        background: Background,
+    ) -> usize {
+        if let Some(i) = self.pipelines.iter().position(|(b, _, _)| *b == background) {
+            return i;
+        }
+        let mut entries = vec![bind::texture_entry(0, UNFILTERABLE)];
+        match background {
+            Background::Sky => {}
+            Background::Terrain => entries.push(bind::texture_entry(1, UNFILTERABLE)),
+            Background::ExternalDepth => {
+                entries.push(bind::texture_entry(1, wgpu::TextureSampleType::Depth))
+            }
+        }
+        let layout = bind::layout(device, "composite.group1", &entries);
+        let module = bind::module(device, "composite", shaders::composite_pass(background));
+        let blend = (background == Background::ExternalDepth)
+            .then_some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
+        let encode = if target_format.is_srgb() { 0.0 } else { 1.0 };
+        let mut constants = constants.to_vec();
+        constants.push(("ENCODE_SRGB", encode));
+        let pipeline = bind::full_screen_pipeline(
+            device,
+            "composite",
+            &module,
+            &[group0, &layout],
+            &[Some(wgpu::ColorTargetState {
+                format: target_format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+            None,
+            &constants,
+        );
+        self.pipelines.push((background, pipeline, layout));
+        self.pipelines.len() - 1
+    }
+
+    /// Records the pass: `clouds` over `background` (whose texture, for
+    /// the terrain's colour or an external depth buffer, is `behind`) into
+    /// `target`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        rec: &mut Recorder,
+        device: &wgpu::Device,
+        inputs: &Inputs,
+        constants: &[(&str, f64)],
+        target: &wgpu::TextureView,
+        background: Background,
+        clouds: &wgpu::TextureView,
+        behind: Option<&wgpu::TextureView>,
+    ) {
+        let i = self.pipeline(
+            device,
+            &inputs.layout,
+            constants,
+            target.texture().format(),
+            background,
+        );
+        let mut resources = vec![wgpu::BindingResource::TextureView(clouds)];
+        resources.extend(behind.map(wgpu::BindingResource::TextureView));
+        let (_, pipeline, layout) = &self.pipelines[i];
+        let group1 = bind::bind(device, "composite.group1", layout, &resources);
+        let mut pass = rec.begin(
+            PASS_COMPOSITE,
+            &[bind::color_attachment(target, None)],
+            None,
+        );
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &inputs.group, &[]);
+        pass.set_bind_group(1, &group1, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

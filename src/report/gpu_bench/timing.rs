@@ -1,0 +1,95 @@
+//! Timing one configuration: the cloud-map renderer or the per-parcel
+//! baseline, and the row that reports it.
+
+use super::{BenchOptions, Row};
+use crate::prepare::Prepared;
+use crate::render::gpu::baseline::BaselineRenderer;
+use crate::render::gpu::headless::TARGET_FORMAT;
+use crate::render::gpu::timer::{FrameTimes, time_frames};
+use crate::render::gpu::{GpuContext, GpuError, textures};
+use crate::scene::RenderSettings;
+
+struct Features {
+    tsaa: bool,
+    terrain: bool,
+    shadow_steps: u32,
+    octaves: u32,
+    detail: bool,
+}
+
+fn features_of(r: &RenderSettings) -> Features {
+    Features {
+        tsaa: r.tsaa,
+        terrain: r.terrain.enabled,
+        shadow_steps: r.shadow_steps,
+        octaves: r.octaves,
+        detail: r.detail_strength > 0.0,
+    }
+}
+
+/// Times the cloud-map renderer on `p` with `r`.
+pub(super) fn time_cloud_map(
+    ctx: &GpuContext,
+    p: &Prepared,
+    r: &RenderSettings,
+    o: &BenchOptions,
+) -> Result<FrameTimes, GpuError> {
+    let mut hl = p.headless(ctx, &p.gpu_settings(r, r.quality()), r.width, r.height)?;
+    hl.time_frames(ctx, &r.camera(), o.warmup, o.frames)
+}
+
+/// Times the per-parcel baseline on `p`'s parcels with `r`.
+pub(super) fn time_baseline(
+    ctx: &GpuContext,
+    p: &Prepared,
+    r: &RenderSettings,
+    o: &BenchOptions,
+) -> Result<FrameTimes, GpuError> {
+    let settings = p.gpu_settings(r, r.quality());
+    let mut b = BaselineRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+    b.update_spheres(&p.spheres());
+    b.resize(r.width, r.height);
+    let target = textures::create_2d(
+        &ctx.device,
+        "bench.target",
+        r.width,
+        r.height,
+        TARGET_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let view = target.create_view(&Default::default());
+    let camera = r.camera();
+    time_frames(ctx, o.warmup, o.frames, |enc, q| {
+        b.render(enc, &view, &camera, q);
+        Ok(1)
+    })
+}
+
+pub(super) fn row(
+    group: &'static str,
+    renderer: &'static str,
+    r: &RenderSettings,
+    p: &Prepared,
+    t: Option<&FrameTimes>,
+    frames: u32,
+) -> Row {
+    let f = features_of(r);
+    Row {
+        group,
+        renderer,
+        width: r.width,
+        height: r.height,
+        coverage: r.coverage,
+        parcels: p.parcels.len(),
+        tsaa: f.tsaa,
+        terrain: f.terrain,
+        shadow_steps: f.shadow_steps,
+        octaves: f.octaves,
+        detail: f.detail,
+        frames: if t.is_some() { frames } else { 0 },
+        p_covered: p.field.covered_fraction(),
+        median_ms: t.map_or(f64::NAN, FrameTimes::median),
+        p95_ms: t.map_or(f64::NAN, FrameTimes::p95),
+        timing: t.map_or("skipped", FrameTimes::source),
+    }
+}

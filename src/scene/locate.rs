@@ -1,0 +1,51 @@
+//! Where a key is in a scene's TOML text, for errors that name the line.
+
+/// 1-based line and column of byte `offset` in `text`.
+pub(super) fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, column)
+}
+
+/// 1-based line of the dotted `key` (e.g. `physics.sph.sound_speed_mps`) in
+/// TOML text: the line `name = ...` under the table header of its parent
+/// (or written dotted from a parent table).
+pub fn locate_key(text: &str, key: &str) -> Option<usize> {
+    let parts: Vec<&str> = key.split('.').collect();
+    let mut table: Vec<String> = Vec::new();
+    for (n, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if let Some(h) = line.strip_prefix('[') {
+            let h = h.trim_start_matches('[').split(']').next().unwrap_or("");
+            table = h.split('.').map(|s| s.trim().to_owned()).collect();
+            continue;
+        }
+        let Some((lhs, _)) = line.split_once('=') else {
+            continue;
+        };
+        let mut full: Vec<String> = table.clone();
+        full.extend(
+            lhs.split('.')
+                .map(|s| s.trim().trim_matches('"').to_owned()),
+        );
+        if full.len() == parts.len() && full.iter().zip(&parts).all(|(a, b)| a == b) {
+            return Some(n + 1);
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn locate_key_finds_table_and_dotted_keys() {
+        let t = "name = \"x\"\n[physics]\ndt_s = 1\nsph.sound_speed_mps = 2\n[physics.wind]\nspeed_mps = -1\n";
+        assert_eq!(locate_key(t, "physics.dt_s"), Some(3));
+        assert_eq!(locate_key(t, "physics.sph.sound_speed_mps"), Some(4));
+        assert_eq!(locate_key(t, "physics.wind.speed_mps"), Some(6));
+        assert_eq!(locate_key(t, "physics.radius_m"), None);
+    }
+}

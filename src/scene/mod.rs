@@ -1,0 +1,252 @@
+//! Scene files (TOML): the atmosphere, the physics, the projection and the
+//! picture, one section type each (`atmosphere.rs`, `sim::PhysicsConfig`,
+//! `projection.rs`, `render.rs`), each checking its own values. Every key
+//! is listed with unit and default in `docs/scene.md` (a test checks that
+//! none is missing). Errors name the file, line and key.
+
+mod atmosphere;
+mod locate;
+mod projection;
+mod render;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use atmosphere::AtmosphereSection;
+use locate::line_col;
+pub use locate::locate_key;
+pub use projection::ProjectionSection;
+pub use render::RenderSettings;
+
+use crate::sim::lift::surface_lcl_height;
+use crate::sim::{Atmosphere, Band, PhysicsConfig, Sounding, SoundingError};
+
+/// What went wrong with a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{path}: cannot read scene: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("{path}{}: `{key}`: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Invalid {
+        path: PathBuf,
+        line: Option<usize>,
+        key: String,
+        message: String,
+    },
+    #[error(transparent)]
+    Sounding(#[from] SoundingError),
+}
+
+/// A scene.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Scene {
+    /// Display name.
+    pub name: String,
+    /// One line on what the scene shows.
+    pub description: String,
+    pub atmosphere: AtmosphereSection,
+    pub physics: PhysicsConfig,
+    pub projection: ProjectionSection,
+    pub render: RenderSettings,
+    /// Where the scene was read from (not a key).
+    #[serde(skip)]
+    pub source: Option<PathBuf>,
+    #[serde(skip)]
+    text: Option<String>,
+}
+
+impl Scene {
+    /// Reads, parses and validates a scene file.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and validates scene text; `path` names it in errors and
+    /// anchors relative sounding paths.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, SceneError> {
+        let mut scene: Scene = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
+            SceneError::Parse {
+                path: path.to_owned(),
+                line,
+                column,
+                message: e.message().trim().to_owned(),
+            }
+        })?;
+        scene.source = Some(path.to_owned());
+        scene.text = Some(text.to_owned());
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Checks every value against its domain, each section with its own
+    /// checks; the error names the first key that fails and, when the
+    /// scene came from a file, its line.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let checks = [
+            self.physics.checks(),
+            self.projection.size_checks(),
+            self.render.checks(),
+            self.atmosphere.override_checks(),
+            self.projection.band_checks(),
+            self.atmosphere.profile_checks(),
+        ];
+        match checks.into_iter().flatten().find(|c| !c.ok) {
+            None => Ok(()),
+            Some(c) => {
+                Err(self.invalid(&c.key, format!("is {}, expected {}", c.value, c.expected)))
+            }
+        }
+    }
+
+    /// An error about `key`, located in the scene text when there is one.
+    pub fn invalid(&self, key: &str, message: String) -> SceneError {
+        SceneError::Invalid {
+            path: self
+                .source
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("<scene>")),
+            line: self.text.as_deref().and_then(|t| locate_key(t, key)),
+            key: key.to_owned(),
+            message,
+        }
+    }
+
+    /// The scene as TOML text for a file at `path`: a sounding path is
+    /// rewritten so that it still names the same file from there
+    /// (absolute when the scene's own directory is unknown).
+    pub fn to_toml(&self, path: &Path) -> Result<String, SceneError> {
+        let mut out = self.clone();
+        if let Some(here) = self.atmosphere.sounding_path(self.source.as_deref()) {
+            let abs = std::fs::canonicalize(&here).unwrap_or(here);
+            let dir = path.parent().and_then(|d| std::fs::canonicalize(d).ok());
+            out.atmosphere.sounding = Some(
+                match dir.and_then(|d| abs.strip_prefix(&d).ok().map(Path::to_owned)) {
+                    Some(r) => r,
+                    None => abs,
+                },
+            );
+        }
+        toml::to_string_pretty(&out).map_err(|e| SceneError::Invalid {
+            path: path.to_owned(),
+            line: None,
+            key: "scene".into(),
+            message: format!("cannot be written as TOML: {e}"),
+        })
+    }
+
+    /// Writes the scene to `path` atomically ([`Self::to_toml`]); it loads
+    /// back with the same settings ([`Self::same_settings`]).
+    pub fn save(&self, path: &Path) -> Result<(), SceneError> {
+        let text = self.to_toml(path)?;
+        crate::io::write_atomically(path, |out| out.write_all(text.as_bytes())).map_err(|source| {
+            SceneError::Io {
+                path: path.to_owned(),
+                source,
+            }
+        })
+    }
+
+    /// Whether two scenes describe the same sky (every section equal, the
+    /// sounding compared by the file it resolves to; the file they came
+    /// from is not compared).
+    pub fn same_settings(&self, other: &Scene) -> bool {
+        let resolve = |s: &Scene| {
+            s.atmosphere
+                .sounding_path(s.source.as_deref())
+                .map(|p| std::fs::canonicalize(&p).unwrap_or(p))
+        };
+        let strip = |s: &Scene| AtmosphereSection {
+            sounding: None,
+            ..s.atmosphere.clone()
+        };
+        self.name == other.name
+            && self.description == other.description
+            && strip(self) == strip(other)
+            && resolve(self) == resolve(other)
+            && self.physics == other.physics
+            && self.projection == other.projection
+            && self.render == other.render
+    }
+
+    /// Builds the atmosphere (reading the sounding, relative to the scene
+    /// file, if the scene names one). `sounding_override` replaces it.
+    pub fn atmosphere(&self, sounding_override: Option<&Path>) -> Result<Atmosphere, SceneError> {
+        let a = &self.atmosphere;
+        let surface = a.surface_pressure_hpa.unwrap_or(1013.25) * 100.0;
+        let sounding_path = match sounding_override {
+            Some(p) => Some(p.to_owned()),
+            None => a.sounding_path(self.source.as_deref()),
+        };
+        let atm = match sounding_path {
+            Some(p) => {
+                let s = Sounding::load(&p, surface)?;
+                Atmosphere::from_sounding(&s)
+            }
+            None => Atmosphere::from_parametric(&a.parametric.unwrap_or_default()),
+        };
+        Ok(match a.inversion_base_m {
+            Some(z) => atm.with_inversion_base(z),
+            None => atm,
+        })
+    }
+
+    /// The cloud band: the scene's values, else the surface air's LCL to the
+    /// inversion base (LCL + 1500 m without an inversion).
+    pub fn band(&self, atm: &Atmosphere) -> Band {
+        let lcl = surface_lcl_height(atm).unwrap_or(500.0);
+        let bottom = self.projection.band_bottom_m.unwrap_or(lcl);
+        let top = self
+            .projection
+            .band_top_m
+            .or(atm.inversion_base_m().filter(|&z| z > bottom + 50.0))
+            .unwrap_or(bottom + 1500.0);
+        Band {
+            bottom_m: bottom,
+            top_m: top.max(bottom + 1.0),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn negative_radius_names_key_and_line() {
+        let e = Scene::parse(
+            "[physics]\nparcels = 3\nradius_m = -5\n",
+            Path::new("s.toml"),
+        )
+        .expect_err("negative");
+        assert_eq!(
+            e.to_string(),
+            "s.toml:3: `physics.radius_m`: is -5, expected a radius > 0 m"
+        );
+    }
+
+    #[test]
+    fn unknown_key_names_line() {
+        let e = Scene::parse("[physics]\nparcels = 3\nradius = 5\n", Path::new("s.toml"))
+            .expect_err("unknown");
+        let msg = e.to_string();
+        assert!(msg.starts_with("s.toml:3:"), "{msg}");
+        assert!(msg.contains("unknown field `radius`"), "{msg}");
+    }
+}

@@ -1,0 +1,266 @@
+//! `[render]`: the picture (size, camera, sun), the density and quality
+//! knobs, the cloud map and the terrain. Every key is in `docs/scene.md`.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::render::cloud_map::CloudMapConfig;
+use crate::render::cpu::camera::Camera;
+use crate::render::cpu::renderer::Quality;
+use crate::render::terrain::TerrainConfig;
+use crate::sim::Check;
+
+/// The `[render]` scene table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderSettings {
+    /// Image width, pixels (1..=8192). Default 640.
+    pub width: u32,
+    /// Image height, pixels (1..=8192). Default 480.
+    pub height: u32,
+    /// Camera position `[x east, y up, z north]`, m. Default `[0, 100, 0]`.
+    pub camera_position_m: [f32; 3],
+    /// Camera heading, degrees clockwise from north. Default 20.
+    pub camera_yaw_deg: f32,
+    /// Camera pitch above the horizon, degrees (-89..=89). Default 12.
+    pub camera_pitch_deg: f32,
+    /// Vertical field of view, degrees (1..=170). Default 60.
+    pub fov_deg: f32,
+    /// Sun elevation above the horizon, degrees (-10..=90). Default 40.
+    pub sun_elevation_deg: f32,
+    /// Sun azimuth, degrees clockwise from north. Default 135.
+    pub sun_azimuth_deg: f32,
+    /// Fraction of each P-covered cloud-map cell that becomes cloud, 0..=1.
+    /// Default 0.75.
+    pub coverage: f32,
+    /// Extinction of the densest cloud, 1/m (> 0). Default 0.04.
+    pub extinction_per_m: f32,
+    /// Strength of the 3D detail noise eroding edges, 0..=1 (0: off, not
+    /// evaluated). Default 0.5.
+    pub detail_strength: f32,
+    /// Size of the detail noise's features, m (> 0). Default 250.
+    pub detail_scale_m: f32,
+    /// Primary march steps (1..=4096). Default 48 (chosen from
+    /// `cumulus render --quality-report`, see README).
+    pub steps: u32,
+    /// Shadow march steps toward the sun (0..=64; 0 = off). Default 6.
+    pub shadow_steps: u32,
+    /// Multiple-scattering octaves beyond the first (0..=3). Default 2.
+    pub octaves: u32,
+    /// Aerial-perspective distance, m (> 0). Default 25000.
+    pub haze_distance_m: f32,
+    /// Longest ray, m (> 0). Default 40000.
+    pub max_distance_m: f32,
+    /// Exposure before tone mapping (> 0). Default 1.2.
+    pub exposure: f32,
+    /// Physics seconds simulated before the picture (>= 0). Default 2400.
+    pub time_s: f64,
+    /// Temporal anti-aliasing on the GPU (the CPU reference never jitters).
+    /// Off: no jitter, no history textures, no TSAA pass. Default true.
+    pub tsaa: bool,
+    /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
+    pub tsaa_blend: f32,
+    /// The cloud map (`[render.cloud_map]`).
+    pub cloud_map: CloudMapConfig,
+    /// The terrain (`[render.terrain]`), off by default.
+    pub terrain: TerrainConfig,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            camera_position_m: [0.0, 100.0, 0.0],
+            camera_yaw_deg: 20.0,
+            camera_pitch_deg: 12.0,
+            fov_deg: 60.0,
+            sun_elevation_deg: 40.0,
+            sun_azimuth_deg: 135.0,
+            coverage: 0.75,
+            extinction_per_m: 0.04,
+            detail_strength: 0.5,
+            detail_scale_m: 250.0,
+            steps: 48,
+            shadow_steps: 6,
+            octaves: 2,
+            haze_distance_m: 25_000.0,
+            max_distance_m: 40_000.0,
+            exposure: 1.2,
+            time_s: 2400.0,
+            tsaa: true,
+            tsaa_blend: 0.1,
+            cloud_map: Default::default(),
+            terrain: TerrainConfig::default(),
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Every key against its domain.
+    pub fn checks(&self) -> Vec<Check> {
+        let r = self;
+        let f = |v: f32| v as f64;
+        let range = Check::range;
+        vec![
+            Check::new(
+                "render.width",
+                (1..=8192).contains(&r.width),
+                "1..=8192 pixels",
+                f(r.width as f32),
+            ),
+            Check::new(
+                "render.height",
+                (1..=8192).contains(&r.height),
+                "1..=8192 pixels",
+                f(r.height as f32),
+            ),
+            Check::new(
+                "render.camera_position_m",
+                r.camera_position_m.iter().all(|x| x.is_finite()),
+                "three finite numbers [x, y, z] in m",
+                f(r.camera_position_m[1]),
+            ),
+            Check::new(
+                "render.camera_yaw_deg",
+                r.camera_yaw_deg.is_finite(),
+                "a finite angle",
+                f(r.camera_yaw_deg),
+            ),
+            range(
+                "render.camera_pitch_deg",
+                f(r.camera_pitch_deg),
+                -89.0,
+                89.0,
+                "-89..=89 degrees",
+            ),
+            range(
+                "render.fov_deg",
+                f(r.fov_deg),
+                1.0,
+                170.0,
+                "1..=170 degrees",
+            ),
+            range(
+                "render.sun_elevation_deg",
+                f(r.sun_elevation_deg),
+                -10.0,
+                90.0,
+                "-10..=90 degrees",
+            ),
+            Check::new(
+                "render.sun_azimuth_deg",
+                r.sun_azimuth_deg.is_finite(),
+                "a finite angle",
+                f(r.sun_azimuth_deg),
+            ),
+            range("render.coverage", f(r.coverage), 0.0, 1.0, "0..=1"),
+            range(
+                "render.extinction_per_m",
+                f(r.extinction_per_m),
+                1e-6,
+                10.0,
+                "> 0 1/m",
+            ),
+            Check::new(
+                "render.steps",
+                (1..=4096).contains(&r.steps),
+                "1..=4096",
+                r.steps as f64,
+            ),
+            Check::new(
+                "render.shadow_steps",
+                r.shadow_steps <= 64,
+                "0..=64",
+                r.shadow_steps as f64,
+            ),
+            Check::new("render.octaves", r.octaves <= 3, "0..=3", r.octaves as f64),
+            range(
+                "render.haze_distance_m",
+                f(r.haze_distance_m),
+                1.0,
+                1e7,
+                "> 0 m",
+            ),
+            range(
+                "render.max_distance_m",
+                f(r.max_distance_m),
+                1.0,
+                1e7,
+                "> 0 m",
+            ),
+            range("render.exposure", f(r.exposure), 1e-3, 1e3, "> 0"),
+            range("render.time_s", r.time_s, 0.0, 1e7, "0..=1e7 s"),
+            range("render.tsaa_blend", f(r.tsaa_blend), 1e-3, 1.0, "0.001..=1"),
+            Check::new(
+                "render.cloud_map.size",
+                (16..=2048).contains(&r.cloud_map.size),
+                "16..=2048 texels",
+                r.cloud_map.size as f64,
+            ),
+            range(
+                "render.cloud_map.cells",
+                r.cloud_map.cells,
+                1.0,
+                64.0,
+                "1..=64",
+            ),
+            range(
+                "render.cloud_map.detail",
+                r.cloud_map.detail,
+                1.0,
+                256.0,
+                "1..=256",
+            ),
+            range(
+                "render.terrain.relief_m",
+                f(r.terrain.relief_m),
+                0.0,
+                5000.0,
+                "0..=5000 m",
+            ),
+            range(
+                "render.terrain.extent_m",
+                f(r.terrain.extent_m),
+                1.0,
+                1e7,
+                "> 0 m",
+            ),
+            range("render.terrain.hills", r.terrain.hills, 1.0, 64.0, "1..=64"),
+            Check::new(
+                "render.terrain.size",
+                (16..=2048).contains(&r.terrain.size),
+                "16..=2048 texels",
+                r.terrain.size as f64,
+            ),
+            Check::new(
+                "render.cloud_map.octaves",
+                (1..=8).contains(&r.cloud_map.octaves),
+                "1..=8",
+                r.cloud_map.octaves as f64,
+            ),
+        ]
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> Camera {
+        Camera {
+            position_m: Vec3::from_array(self.camera_position_m),
+            yaw_deg: self.camera_yaw_deg,
+            pitch_deg: self.camera_pitch_deg,
+            fov_deg: self.fov_deg,
+        }
+    }
+
+    /// The quality knobs.
+    pub fn quality(&self) -> Quality {
+        Quality {
+            steps: self.steps,
+            shadow_steps: self.shadow_steps,
+            octaves: self.octaves,
+            haze_distance_m: self.haze_distance_m,
+            max_distance_m: self.max_distance_m,
+            exposure: self.exposure,
+        }
+    }
+}

@@ -1,0 +1,184 @@
+//! The WGSL and its CPU twins, checked by machine with naga (no GPU
+//! needed): every WGSL function is the twin of a Rust function of the same
+//! name under `src/render/`, or on the short GPU-only list below with the
+//! reason; every WGSL constant equals its Rust twin; the `Frame` uniform's
+//! members sit at the offsets of `FrameUniforms`' fields, and `Sphere`'s at
+//! those of the baseline's `Sphere`.
+
+use std::collections::BTreeSet;
+use std::mem::offset_of;
+use std::path::Path;
+
+use cumulus::render::cpu::{density, lighting, renderer, sky};
+use cumulus::render::gpu::baseline::Sphere;
+use cumulus::render::gpu::shaders::all_variants;
+use cumulus::render::gpu::uniforms::FrameUniforms;
+
+/// WGSL functions with no Rust function of the same name, and why.
+const GPU_ONLY: &[(&str, &str)] = &[
+    // The CPU renderer calls `Camera::ray` (a method).
+    ("camera_ray", "the CPU's Camera::ray"),
+    // The fragment body of the cloud pass; the CPU loop is render_linear.
+    ("cloud_pixel", "per-pixel glue around march_ray"),
+    // The GPU's early exit over empty sky; the CPU has CoverageMask::build
+    // and tests the mask conservative against density_at.
+    ("coarse_empty", "reads CoverageMask's cells"),
+    // Reads the depth buffer; the CPU intersects the heightfield instead.
+    ("depth_to_distance", "no depth buffer on the CPU"),
+    // Tone map plus sRGB encode of the composite; the CPU's to_srgb8.
+    ("display", "the CPU's to_srgb8"),
+    ("srgb_encode", "inside the CPU's to_srgb8"),
+    // glam's Vec3::normalize_or on the CPU.
+    ("normalize_or", "glam's Vec3::normalize_or"),
+    // The composite's background: sky_radiance + sun_disk on the CPU.
+    ("sky_background", "sky_radiance + sun_disk per pixel"),
+    ("sky_above", "the zenith sky, precomputed in FrameUniforms"),
+    // Integer wrap of texel indices (rem_euclid on the CPU).
+    ("wrap_i", "i64::rem_euclid on the CPU"),
+    // The per-parcel baseline exists only on the GPU, for `cumulus bench`.
+    ("march_spheres", "baseline renderer, GPU only"),
+    ("sphere_density", "baseline renderer, GPU only"),
+    ("sphere_optical_depth", "baseline renderer, GPU only"),
+    ("sphere_span", "baseline renderer, GPU only"),
+];
+
+/// Every WGSL constant and its Rust twin's value.
+fn rust_constants() -> Vec<(&'static str, f64)> {
+    vec![
+        ("PI", std::f32::consts::PI as f64),
+        ("BASE_RAMP", density::BASE_RAMP as f64),
+        ("REFINE", renderer::REFINE as f64),
+        ("ALBEDO", renderer::ALBEDO as f64),
+        ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE as f64),
+        ("SUN_DISK_COS", sky::SUN_DISK_COS as f64),
+        ("SHADOW_RAY_M", lighting::SHADOW_RAY_M as f64),
+    ]
+}
+
+fn modules() -> Vec<naga::Module> {
+    all_variants()
+        .iter()
+        .map(|src| {
+            naga::front::wgsl::parse_str(src)
+                .unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)))
+        })
+        .collect()
+}
+
+/// Every `.rs` file's text under `dir`.
+fn rust_sources(dir: &Path, out: &mut String) {
+    for entry in std::fs::read_dir(dir).expect("src/render") {
+        let path = entry.expect("entry").path();
+        if path.is_dir() {
+            rust_sources(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push_str(&std::fs::read_to_string(&path).expect("read"));
+        }
+    }
+}
+
+fn has_rust_fn(sources: &str, name: &str) -> bool {
+    sources.contains(&format!("fn {name}(")) || sources.contains(&format!("fn {name}<"))
+}
+
+#[test]
+fn every_wgsl_function_has_a_rust_twin_or_a_reason() {
+    let mut wgsl = BTreeSet::new();
+    for m in modules() {
+        for (_, f) in m.functions.iter() {
+            wgsl.extend(f.name.clone());
+        }
+    }
+    let mut rust = String::new();
+    rust_sources(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src/render"),
+        &mut rust,
+    );
+    let gpu_only: BTreeSet<&str> = GPU_ONLY.iter().map(|(n, _)| *n).collect();
+    let mut missing = Vec::new();
+    for name in &wgsl {
+        let twin = has_rust_fn(&rust, name);
+        let listed = gpu_only.contains(name.as_str());
+        if twin == listed {
+            missing.push(if twin {
+                format!("{name}: on GPU_ONLY but has a Rust twin (take it off the list)")
+            } else {
+                format!("{name}: no Rust fn {name} under src/render and not on GPU_ONLY")
+            });
+        }
+    }
+    for name in &gpu_only {
+        if !wgsl.contains(*name) {
+            missing.push(format!(
+                "{name}: on GPU_ONLY but no WGSL function has that name"
+            ));
+        }
+    }
+    assert!(missing.is_empty(), "{missing:#?}");
+    // The twins are most of the shader, not a token few.
+    assert!(wgsl.len() - gpu_only.len() >= 20, "{wgsl:?}");
+}
+
+#[test]
+fn every_wgsl_constant_equals_its_rust_twin() {
+    let rust = rust_constants();
+    let mut seen = BTreeSet::new();
+    for m in modules() {
+        for (_, c) in m.constants.iter() {
+            let Some(name) = &c.name else { continue };
+            let value = match m.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::F32(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::U32(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::I32(v)) => v as f64,
+                ref e => panic!("WGSL const {name} is not a plain literal: {e:?}"),
+            };
+            let Some((_, twin)) = rust.iter().find(|(n, _)| n == name) else {
+                panic!("WGSL const {name} has no Rust twin in rust_constants()");
+            };
+            assert_eq!(value as f32, *twin as f32, "const {name}");
+            seen.insert(name.clone());
+        }
+    }
+    for (name, _) in rust {
+        assert!(seen.contains(name), "no WGSL const {name}");
+    }
+}
+
+/// The members of the WGSL struct `name` as (member, byte offset).
+fn wgsl_struct(name: &str) -> (Vec<(String, u32)>, u32) {
+    for m in modules() {
+        for (_, t) in m.types.iter() {
+            if t.name.as_deref() == Some(name)
+                && let naga::TypeInner::Struct { members, span } = &t.inner
+            {
+                let ms = members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                    .collect();
+                return (ms, *span);
+            }
+        }
+    }
+    panic!("no WGSL struct {name}");
+}
+
+fn same_layout(name: &str, rust: &[(&str, usize)], rust_size: usize) {
+    let (wgsl, span) = wgsl_struct(name);
+    assert_eq!(span as usize, rust_size, "{name}: size");
+    let wgsl: Vec<(String, usize)> = wgsl.into_iter().map(|(n, o)| (n, o as usize)).collect();
+    let rust: Vec<(String, usize)> = rust.iter().map(|(n, o)| (n.to_string(), *o)).collect();
+    assert_eq!(wgsl, rust, "{name}: members and offsets");
+}
+
+#[test]
+fn frame_uniform_members_match_frame_uniforms_offsets() {
+    macro_rules! offsets {
+        ($t:ty: $($f:ident),*) => { [$((stringify!($f), offset_of!($t, $f))),*] };
+    }
+    let rust = offsets!(FrameUniforms: cam_pos, cam_forward, cam_right, cam_up, sun_dir,
+        sun_light, ambient_top, sky_up, band, map, jitter, depth, counts, mask, view_proj,
+        prev_view_proj);
+    same_layout("Frame", &rust, size_of::<FrameUniforms>());
+    let rust = offsets!(Sphere: centre_radius, fill);
+    same_layout("Sphere", &rust, size_of::<Sphere>());
+}

@@ -1,0 +1,182 @@
+//! The architecture invariants of ARCHITECTURE.md, checked on the source
+//! text (as rust-analyzer's tidy tests do): each test names the file and
+//! line that breaks its rule. Comments are not code: lines starting with
+//! `//` are skipped.
+
+use std::path::{Path, PathBuf};
+
+/// Every `.rs` file under `src/<dir>`, with its code lines (line number,
+/// text), comments left out.
+fn code(dir: &str) -> Vec<(PathBuf, Vec<(usize, String)>)> {
+    fn walk(p: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(p).expect("read_dir") {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|e| e == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(dir);
+    let mut files = Vec::new();
+    walk(&root, &mut files);
+    files.sort();
+    files
+        .into_iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(&f).expect("read");
+            let lines = text
+                .lines()
+                .enumerate()
+                .filter(|(_, l)| !l.trim_start().starts_with("//"))
+                .map(|(i, l)| (i + 1, l.to_owned()))
+                .collect();
+            (f, lines)
+        })
+        .collect()
+}
+
+/// `file:line: text` for every code line under `src/<dir>` (files for which
+/// `skip` is false) that `bad` flags.
+fn offences(dir: &str, skip: impl Fn(&Path) -> bool, bad: impl Fn(&str) -> bool) -> Vec<String> {
+    let mut out = Vec::new();
+    for (file, lines) in code(dir) {
+        if skip(&file) {
+            continue;
+        }
+        for (n, l) in lines {
+            if bad(&l) {
+                out.push(format!("{}:{n}: {}", file.display(), l.trim()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn sim_depends_on_nothing_graphical_nor_on_scene_or_report() {
+    let banned = [
+        "wgpu",
+        "winit",
+        "egui",
+        "crate::render",
+        "crate::scene",
+        "crate::report",
+        "crate::prepare",
+        "crate::panel",
+    ];
+    let o = offences("sim", |_| false, |l| banned.iter().any(|b| l.contains(b)));
+    assert!(
+        o.is_empty(),
+        "sim/ reaches outside the simulator:\n{}",
+        o.join("\n")
+    );
+}
+
+/// The first path segments named after `crate::sim::` on a line:
+/// `crate::sim::{Band, ProjectedField}` gives both names.
+fn sim_items(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = line;
+    while let Some(i) = rest.find("crate::sim") {
+        rest = &rest[i + "crate::sim".len()..];
+        let Some(after) = rest.strip_prefix("::") else {
+            // `use crate::sim;` names the whole simulator.
+            out.push("sim".to_owned());
+            continue;
+        };
+        if let Some(group) = after.strip_prefix('{') {
+            let inner = group.split('}').next().unwrap_or("");
+            for item in inner.split(',') {
+                let first = item.trim().split("::").next().unwrap_or("").trim();
+                if !first.is_empty() {
+                    out.push(first.to_owned());
+                }
+            }
+        } else {
+            let name: String = after
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            out.push(name);
+        }
+    }
+    out
+}
+
+#[test]
+fn render_sees_the_simulation_only_through_p() {
+    let allowed = ["ProjectedField", "Band", "projection"];
+    let o = offences(
+        "render",
+        |_| false,
+        |l| {
+            sim_items(l).iter().any(|n| !allowed.contains(&n.as_str()))
+                || [
+                    "crate::scene",
+                    "crate::prepare",
+                    "crate::report",
+                    "crate::panel",
+                ]
+                .iter()
+                .any(|b| l.contains(b))
+        },
+    );
+    assert!(
+        o.is_empty(),
+        "render/ reaches into the simulator beyond P (ProjectedField, Band) or into the scene:\n{}",
+        o.join("\n")
+    );
+}
+
+#[test]
+fn sim_items_reads_use_lines() {
+    assert_eq!(
+        sim_items("use crate::sim::{Band, ProjectedField};"),
+        ["Band", "ProjectedField"]
+    );
+    assert_eq!(sim_items("use crate::sim::Parcels;"), ["Parcels"]);
+    assert_eq!(
+        sim_items("f(crate::sim::projection::Band { })"),
+        ["projection"]
+    );
+    assert_eq!(sim_items("use crate::sim;"), ["sim"]);
+}
+
+#[test]
+fn only_the_binaries_edge_reads_the_environment() {
+    let banned = ["env::var", "var_os(", "from_env(", "env::args", "env::vars"];
+    let o = offences(
+        "",
+        |f| f.components().any(|c| c.as_os_str() == "bin"),
+        |l| banned.iter().any(|b| l.contains(b)),
+    );
+    assert!(
+        o.is_empty(),
+        "the library reads the environment:\n{}",
+        o.join("\n")
+    );
+}
+
+#[test]
+fn output_files_are_written_only_through_the_atomic_writer() {
+    let banned = [
+        "File::create",
+        "fs::write(",
+        "OpenOptions",
+        "save_buffer",
+        ".save_with_format(",
+        "fs::copy(",
+    ];
+    let o = offences(
+        "",
+        |f| f.ends_with("src/io.rs"),
+        |l| banned.iter().any(|b| l.contains(b)),
+    );
+    assert!(
+        o.is_empty(),
+        "a file is written outside cumulus::io::write_atomically:\n{}",
+        o.join("\n")
+    );
+}
