@@ -180,3 +180,34 @@ fn output_files_are_written_only_through_the_atomic_writer() {
         o.join("\n")
     );
 }
+
+#[test]
+fn the_codemap_names_every_module() {
+    let arch =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("ARCHITECTURE.md"))
+            .expect("ARCHITECTURE.md");
+    let mut missing = Vec::new();
+    for (file, _) in code("") {
+        let name = file.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        // A folder's mod.rs is named by the folder.
+        let wanted = match name {
+            "lib.rs" => continue,
+            "mod.rs" | "main.rs" => format!(
+                "{}/",
+                file.parent()
+                    .and_then(|d| d.file_name())
+                    .and_then(|n| n.to_str())
+                    .unwrap_or("")
+            ),
+            n => n.to_owned(),
+        };
+        if !arch.contains(&wanted) {
+            missing.push(format!("{} ({wanted})", file.display()));
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "ARCHITECTURE.md does not name:\n{}",
+        missing.join("\n")
+    );
+}
