@@ -2,6 +2,8 @@
 //! clear error (file, line, key), a non-zero exit, no panic and no output
 //! file.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -409,12 +411,7 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
 
 #[test]
 fn render_on_the_gpu_writes_the_png_and_times_frames() {
-    if cumulus::render::gpu::GpuContext::new(wgpu::Backends::all()).is_err() {
-        assert!(
-            std::env::var("CUMULUS_REQUIRE_GPU").ok().as_deref() != Some("1"),
-            "CUMULUS_REQUIRE_GPU=1 but no GPU adapter was found"
-        );
-        eprintln!("SKIPPED: no GPU adapter");
+    if common::gpu().is_none() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
