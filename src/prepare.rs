@@ -13,7 +13,7 @@ use crate::render::gpu::baseline::Sphere;
 use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless, TsaaSettings};
 use crate::render::terrain::Heightfield;
 use crate::scene::{RenderSettings, Scene, SceneError};
-use crate::sim::{Band, Parcels, ProjectedField, Simulation};
+use crate::sim::{Band, FramePlan, Parcels, ProjectedField, Simulation};
 
 /// A scene's textures at one moment.
 pub struct Prepared {
@@ -41,8 +41,9 @@ impl Prepared {
         let l = scene.physics.domain_size_m;
         let mut sim = Simulation::new(scene.physics.clone(), atm);
         sim.set_spawn_sites(spawn_sites(&cloud_map, l));
-        for _ in 0..Self::frames(scene) {
-            sim.step();
+        let plan = FramePlan::new(scene.render.time_s, scene.physics.dt_s);
+        for k in 0..plan.frames() {
+            sim.advance(plan.frame_s(k));
             progress();
         }
         let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
@@ -58,9 +59,10 @@ impl Prepared {
         })
     }
 
-    /// Physics frames simulated before the picture.
+    /// Physics frames simulated before the picture (exactly `time_s`: a
+    /// short last frame when `dt_s` does not divide it).
     pub fn frames(scene: &Scene) -> u64 {
-        (scene.render.time_s / scene.physics.dt_s).round() as u64
+        FramePlan::new(scene.render.time_s, scene.physics.dt_s).frames()
     }
 
     /// The GPU renderer's settings for `r` with `quality`.

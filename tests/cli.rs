@@ -441,3 +441,94 @@ fn render_on_the_gpu_writes_the_png_and_times_frames() {
     let img = image::open(&out).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (40, 30));
 }
+
+/// `--dt-s 7 --duration-s 60` simulated 63 s (nine whole frames); it must
+/// simulate 60 s, the last frame 4 s long, and say so.
+#[test]
+fn a_step_that_does_not_divide_the_duration_simulates_exactly_the_duration() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("curves.csv");
+    let scene = root().join("scenes/fair_weather.toml");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--parcels",
+        "3",
+        "--dt-s",
+        "7",
+        "--duration-s",
+        "60",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("simulated 60 s in 9 frames (8 of 7 s, the last of 4 s)"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let last_t: f64 = text
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .expect("a t_s column");
+    assert!((last_t - 60.0).abs() < 1e-9, "last row at {last_t} s");
+}
+
+#[test]
+fn stats_writes_the_field_statistics() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("stats");
+    let scene = root().join("scenes/fair_weather.toml");
+    let o = cumulus(&[
+        "stats",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "96",
+        "--levels",
+        "12",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("cloud_fraction="), "{stdout}");
+    for f in [
+        "clouds.csv",
+        "size_density.csv",
+        "cloud_fraction_profile.csv",
+        "stats.json",
+        "area_perimeter.png",
+        "size_density.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    let cf = json["cloud_fraction"].as_f64().expect("cloud_fraction");
+    assert!(cf > 0.0 && cf < 1.0, "{cf}");
+    assert_eq!(json["profile"].as_array().map(Vec::len), Some(12));
+}
+
+#[test]
+fn stats_rejects_a_bad_resolution_before_simulating() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("stats");
+    let scene = root().join("scenes/fair_weather.toml");
+    let o = cumulus(&[
+        "stats",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--resolution is 5"), "{}", stderr(&o));
+    assert!(!out.exists());
+}

@@ -220,6 +220,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     .map_err(|source| ReportError::Write { path: csv_path.clone(), source })?;
     let floor = 1e-6;
     let series = |name: &str, f: fn(&Row) -> f64| Series {
+        joined: true,
         name: name.to_owned(),
         points: report
             .rows

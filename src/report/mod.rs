@@ -3,6 +3,7 @@
 
 pub mod convergence;
 pub mod curves;
+pub mod field_stats;
 pub mod gpu_bench;
 pub mod plot;
 pub mod render_quality;

@@ -16,6 +16,8 @@ static REGISTER: Once = Once::new();
 
 /// One named series of `(x, y)` points.
 pub struct Series {
+    /// Points joined by a line (a curve), or alone (a scatter).
+    pub joined: bool,
     pub name: String,
     pub points: Vec<(f64, f64)>,
 }
@@ -37,7 +39,11 @@ fn significant(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }
-    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    let e = v.abs().log10().floor() as i32;
+    if !(-3..6).contains(&e) {
+        return format!("{v:.2e}");
+    }
+    let decimals = (2 - e).max(0) as usize;
     format!("{v:.decimals$}")
 }
 
@@ -98,8 +104,9 @@ pub fn loglog_png(
                 .copied()
                 .filter(|p| p.0 > 0.0 && p.1 > 0.0)
                 .collect();
+            let line = if s.joined { points.clone() } else { Vec::new() };
             chart
-                .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+                .draw_series(LineSeries::new(line, color.stroke_width(2)))
                 .map_err(|e| err(&e))?
                 .label(s.name.clone())
                 .legend(move |(x, y)| {

@@ -149,10 +149,12 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         "abs error of the tone-mapped image (0..1)",
         &[
             Series {
+                joined: true,
                 name: "mean".into(),
                 points: pts(|r| r.mean_error),
             },
             Series {
+                joined: true,
                 name: "max".into(),
                 points: pts(|r| r.max_error),
             },

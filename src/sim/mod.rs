@@ -24,6 +24,6 @@ pub use check::Check;
 pub use config::PhysicsConfig;
 pub use parcels::Parcels;
 pub use projection::{Band, ProjectedField};
-pub use solver::{Simulation, StepStats, Totals};
+pub use solver::{FramePlan, Simulation, StepStats, Totals};
 pub use sounding::{Sounding, SoundingError};
 pub use update::wind_at;

@@ -15,6 +15,51 @@ use super::spawn::{air_mass, refresh_diag, spawn};
 use super::sph::{self, NeighbourGrid, SphParams};
 use super::update::{Ctx, advance_parcel, wind_at};
 
+/// The frames that simulate exactly `duration_s` with frames of `dt_s`:
+/// `full` frames of `dt_s`, then one shorter frame of `last_s` when
+/// `dt_s` does not divide the duration (0: none).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FramePlan {
+    pub dt_s: f64,
+    pub full: u64,
+    pub last_s: f64,
+}
+
+impl FramePlan {
+    /// The plan for `duration_s` (>= 0) in frames of `dt_s` (> 0). A
+    /// quotient within round-off of a whole number counts as whole.
+    pub fn new(duration_s: f64, dt_s: f64) -> Self {
+        let n = (duration_s / dt_s).round();
+        if (n * dt_s - duration_s).abs() <= 1e-9 * duration_s.max(dt_s) {
+            return Self {
+                dt_s,
+                full: n as u64,
+                last_s: 0.0,
+            };
+        }
+        let full = (duration_s / dt_s).floor();
+        Self {
+            dt_s,
+            full: full as u64,
+            last_s: duration_s - full * dt_s,
+        }
+    }
+
+    /// Frames in all, the short one included.
+    pub fn frames(&self) -> u64 {
+        self.full + u64::from(self.last_s > 0.0)
+    }
+
+    /// The length of frame `k` (0-based), s.
+    pub fn frame_s(&self, k: u64) -> f64 {
+        if k < self.full {
+            self.dt_s
+        } else {
+            self.last_s
+        }
+    }
+}
+
 /// Above this many parcels the per-parcel update runs on all cores.
 pub const PARALLEL_THRESHOLD: usize = 1024;
 
@@ -416,5 +461,28 @@ impl Simulation {
             }
         }
         count
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_plan_covers_exactly_the_duration() {
+        for (d, dt) in [
+            (3600.0, 7.0),
+            (3600.0, 5.0),
+            (0.3, 0.1),
+            (1.0, 5.0),
+            (10.5, 2.0),
+        ] {
+            let p = FramePlan::new(d, dt);
+            let total: f64 = (0..p.frames()).map(|k| p.frame_s(k)).sum();
+            assert!((total - d).abs() < 1e-9 * d, "{d} / {dt}: {p:?}");
+            assert!(p.last_s >= 0.0 && p.last_s < dt, "{p:?}");
+        }
+        assert_eq!(FramePlan::new(0.3, 0.1).frames(), 3);
+        assert_eq!(FramePlan::new(3600.0, 7.0).frames(), 515);
     }
 }

@@ -1,5 +1,6 @@
 //! `cumulus`: the command line, one module per command (`simulate.rs`,
-//! `profile.rs`, `convergence.rs`, `render.rs`, `bench.rs`; `scene check`
+//! `profile.rs`, `convergence.rs`, `render.rs`, `bench.rs`, `stats.rs`;
+//! `scene check`
 //! is here). Units are in every flag's name and help text. Errors leave
 //! through `anyhow` with the file, line or field. This is the binary's
 //! edge: the only place that reads the environment (`WGPU_BACKEND`) and
@@ -10,6 +11,7 @@ mod convergence;
 mod profile;
 mod render;
 mod simulate;
+mod stats;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -47,6 +49,10 @@ enum Command {
     /// against a per-parcel baseline), features, the physics' share of the
     /// frame, and render error against GPU time. Writes CSV, JSON and PNGs.
     Bench(bench::BenchArgs),
+    /// Statistics of the cloud field seen from above: cloud fraction and
+    /// its profile by height, the area-perimeter fractal dimension, the
+    /// cloud-size density and its power-law exponent (CSV, JSON, plots).
+    Stats(stats::StatsArgs),
     /// Scene files.
     Scene {
         #[command(subcommand)]
@@ -77,6 +83,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Convergence(a) => convergence::run(a),
         Command::Render(a) => render::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Stats(a) => stats::run(a),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => {

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 
 use cumulus::io::write_atomically;
 use cumulus::report::curves;
-use cumulus::sim::Simulation;
+use cumulus::sim::{FramePlan, Simulation};
 
 use crate::{finite_positive, load_scene, progress_bar, with_overrides};
 
@@ -56,7 +56,10 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     finite_positive("--every-s", every)?;
     let atm = scene.atmosphere(a.sounding.as_deref())?;
     let band = scene.band(&atm);
-    let frames = (a.duration_s / scene.physics.dt_s).round().max(1.0) as u64;
+    // Exactly the duration asked: a short last frame when dt does not
+    // divide it.
+    let plan = FramePlan::new(a.duration_s, scene.physics.dt_s);
+    let frames = plan.frames();
     let write_every = (every / scene.physics.dt_s).round().max(1.0) as u64;
     let mut sim = Simulation::new(scene.physics.clone(), atm);
     let bar = progress_bar(frames, "simulating");
@@ -65,7 +68,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         curves::write_header(&mut w)?;
         curves::write_rows(&mut w, &sim, band)?;
         for f in 1..=frames {
-            sim.step();
+            sim.advance(plan.frame_s(f - 1));
             if f % write_every == 0 || f == frames {
                 curves::write_rows(&mut w, &sim, band)?;
             }
@@ -77,10 +80,22 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     bar.finish_and_clear();
     let t = sim.totals();
     let b = sim.water_budget();
+    // Seconds to the microsecond, without trailing zeros.
+    let secs = |x: f64| (x * 1e6).round() / 1e6;
+    let frames_said = if plan.last_s > 0.0 {
+        format!(
+            "{} frames ({} of {} s, the last of {} s)",
+            t.frames,
+            plan.full,
+            secs(plan.dt_s),
+            secs(plan.last_s)
+        )
+    } else {
+        format!("{} frames of {} s", t.frames, secs(plan.dt_s))
+    };
     eprintln!(
-        "simulated {:.0} s in {} frames ({} sub-steps, {} frames hit the sub-step cap), {} re-births; water budget residual {:.2e} (relative); wrote {}",
-        sim.time_s(),
-        t.frames,
+        "simulated {} s in {frames_said} ({} sub-steps, {} frames hit the sub-step cap), {} re-births; water budget residual {:.2e} (relative); wrote {}",
+        secs(sim.time_s()),
         t.substeps,
         t.capped_frames,
         t.recycled,

@@ -65,6 +65,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
 
     let device = format!("{} ({} timing)", report.adapter, report.timing);
     let series_of = |group: &str, renderer: &str, x: fn(&Row) -> f64| Series {
+        joined: true,
         name: renderer.replace('_', "-"),
         points: report
             .rows
@@ -125,6 +126,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     let series: Vec<Series> = knobs
         .iter()
         .map(|k| Series {
+            joined: true,
             name: k.to_string(),
             points: report
                 .quality

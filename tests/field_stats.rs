@@ -1,0 +1,138 @@
+//! `report::field_stats` on synthetic fields whose answers are known: the
+//! area-perimeter dimension of discs (1) and of quadratic Koch islands
+//! (log 8 / log 4 = 1.5, exactly, on the pixel grid), and the exponent of
+//! a power-law size density.
+
+use cumulus::report::field_stats::{Cloud, Mask, area_perimeter_fit, size_density, size_fit};
+
+/// Tolerance on D: the fit of pixelated outlines over 1.5-2 decades of
+/// area.
+const D_TOLERANCE: f64 = 0.05;
+
+fn blank(w: usize, h: usize) -> Mask {
+    Mask {
+        width: w,
+        height: h,
+        cell_m: 10.0,
+        cells: vec![false; w * h],
+    }
+}
+
+#[test]
+fn discs_have_dimension_one_and_fail_the_natural_range() {
+    let mut clouds = Vec::new();
+    for r in [3.0, 5.0, 8.0, 13.0, 21.0, 34.0, 55.0] {
+        let n = (2.0 * r) as usize + 8;
+        let mut m = blank(n, n);
+        let c = n as f64 / 2.0;
+        for y in 0..n {
+            for x in 0..n {
+                let (dx, dy) = (x as f64 + 0.5 - c, y as f64 + 0.5 - c);
+                m.cells[y * n + x] = dx * dx + dy * dy <= r * r;
+            }
+        }
+        clouds.extend(m.clouds());
+    }
+    assert_eq!(clouds.len(), 7);
+    let d = 2.0 * area_perimeter_fit(&clouds, 1).expect("fit").slope;
+    eprintln!("discs: D = {d:.4}");
+    assert!((d - 1.0).abs() < D_TOLERANCE, "discs: D = {d}");
+    // Real cloud fields: 1.30..=1.40 (Lovejoy 1982); a disc field is not one.
+    assert!(!(1.30..=1.40).contains(&d));
+}
+
+/// The quadratic Koch island of generation `g` on a square of side 4^g
+/// cells (every segment one cell long at the end), as a closed polygon.
+fn koch_island(g: u32) -> Vec<(i64, i64)> {
+    let s = 4i64.pow(g);
+    let mut pts = vec![(0, 0), (s, 0), (s, s), (0, s), (0, 0)];
+    for _ in 0..g {
+        let mut next = vec![pts[0]];
+        for w in pts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let v = ((b.0 - a.0) / 4, (b.1 - a.1) / 4);
+            let n = (-v.1, v.0);
+            let at = |i: i64, j: i64| (a.0 + i * v.0 + j * n.0, a.1 + i * v.1 + j * n.1);
+            next.extend([
+                at(1, 0),
+                at(1, 1),
+                at(2, 1),
+                at(2, 0),
+                at(2, -1),
+                at(3, -1),
+                at(3, 0),
+                b,
+            ]);
+        }
+        pts = next;
+    }
+    pts
+}
+
+/// Cells whose centres the rectilinear polygon `pts` encloses (even-odd
+/// rule along each row), the polygon shifted by `off`.
+fn rasterise(m: &mut Mask, pts: &[(i64, i64)], off: i64) {
+    for y in 0..m.height {
+        let yc = y as f64 + 0.5 - off as f64;
+        let mut xs: Vec<f64> = pts
+            .windows(2)
+            .filter(|w| w[0].0 == w[1].0)
+            .filter(|w| {
+                let (lo, hi) = (w[0].1.min(w[1].1) as f64, w[0].1.max(w[1].1) as f64);
+                lo < yc && yc < hi
+            })
+            .map(|w| (w[0].0 + off) as f64)
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        for pair in xs.chunks_exact(2) {
+            for x in pair[0].ceil() as usize..pair[1].ceil() as usize {
+                m.cells[y * m.width + x] = true;
+            }
+        }
+    }
+}
+
+#[test]
+fn quadratic_koch_islands_have_dimension_one_and_a_half() {
+    let mut clouds = Vec::new();
+    for g in 1..=4 {
+        let s = 4i64.pow(g);
+        let n = (2 * s + 8) as usize;
+        let mut m = blank(n, n);
+        rasterise(&mut m, &koch_island(g), s / 2 + 4);
+        let c = m.clouds();
+        assert_eq!(c.len(), 1, "generation {g}");
+        // The island keeps the square's area; its outline is 4 * 8^g cells.
+        assert_eq!(c[0].cells as i64, s * s, "generation {g}");
+        assert_eq!(c[0].perimeter_m, 10.0 * (4 * 8i64.pow(g)) as f64);
+        clouds.extend(c);
+    }
+    let d = 2.0 * area_perimeter_fit(&clouds, 1).expect("fit").slope;
+    eprintln!("Koch islands: D = {d:.4}");
+    assert!((d - 1.5).abs() < D_TOLERANCE, "Koch islands: D = {d}");
+}
+
+#[test]
+fn a_power_law_of_sizes_gives_its_exponent() {
+    // Diameters at the quantiles of n(d) ∝ d^-2.5 from 100 m up: N(>d)
+    // ∝ d^-1.5.
+    let (n, alpha, d0) = (2000usize, 2.5, 100.0);
+    let clouds: Vec<Cloud> = (0..n)
+        .map(|i| {
+            let d = d0 * ((i as f64 + 0.5) / n as f64).powf(-1.0 / (alpha - 1.0));
+            let area = std::f64::consts::PI * d * d / 4.0;
+            Cloud {
+                cells: 100,
+                area_m2: area,
+                perimeter_m: std::f64::consts::PI * d,
+                diameter_m: d,
+            }
+        })
+        .collect();
+    let bins = size_density(&clouds, 1, 1e10, 5);
+    let (fit, decades) = size_fit(&bins);
+    let slope = fit.expect("fit").slope;
+    eprintln!("power law -2.5: fitted {slope:.3} over {decades:.2} decades");
+    assert!(decades >= 2.0, "{decades} decades");
+    assert!((slope + alpha).abs() < 0.15, "exponent {slope}");
+}
