@@ -205,7 +205,10 @@ pub struct PhysicsConfig {
     /// Initial `θ_l` excess of a released parcel over its environment, K.
     /// Default 0.5 ("initialised parcels are slightly warmer").
     pub initial_excess_k: f64,
-    /// Initial total-water excess of a released parcel, g/kg. Default 1.0.
+    /// Initial total-water excess of a released parcel, g/kg. Capped so the
+    /// parcel cannot saturate below the surface air's LCL: at most the
+    /// saturation mixing ratio of the parcel lifted dry-adiabatically to it
+    /// (in cold air that is less than the excess itself). Default 1.0.
     pub initial_excess_qt_gkg: f64,
     /// Virtual-mass coefficient γ in `dw/dt = B/(1+γ) - ...`. Domain 0..=2.
     /// Default 0.5 (Simpson & Wiggert 1969).

@@ -11,7 +11,7 @@ use super::budget::{CompensatedSum, WaterBudget};
 use super::config::PhysicsConfig;
 use super::parcels::{Diag, Life, Parcels, keyed_uniform};
 use super::projection::{Band, ProjectedField};
-use super::spawn::{air_mass, refresh_diag, spawn};
+use super::spawn::{air_mass, refresh_diag, release_qt_cap, spawn};
 use super::sph::{self, NeighbourGrid, SphParams};
 use super::update::{Ctx, advance_parcel, wind_at};
 
@@ -110,6 +110,8 @@ pub struct Simulation {
     active: Vec<u32>,
     /// Where parcels are born (m, in the domain); empty: anywhere.
     sites: Vec<DVec2>,
+    /// The most water a parcel is born with (`spawn::release_qt_cap`).
+    qt_cap: f64,
 }
 
 /// One parcel's state as the zipped iterators hand it out.
@@ -135,8 +137,9 @@ impl Simulation {
             diag: vec![Diag::default(); n],
             life: vec![Life::default(); n],
         };
+        let qt_cap = release_qt_cap(&cfg, &atm);
         for i in 0..n {
-            spawn(&cfg, &atm, &[], &mut parcels, i, 0);
+            spawn(&cfg, &atm, &[], qt_cap, &mut parcels, i, 0);
             let wait = cfg.release_stagger_s * keyed_uniform(cfg.seed, i as u64, 0, 4);
             parcels.life[i].age_s = -wait;
         }
@@ -154,6 +157,7 @@ impl Simulation {
             sph_acc: Vec::new(),
             active: Vec::new(),
             sites: Vec::new(),
+            qt_cap,
         }
     }
 
@@ -186,6 +190,7 @@ impl Simulation {
             &self.cfg,
             &self.atm,
             &self.sites,
+            self.qt_cap,
             &mut self.parcels,
             i,
             generation,

@@ -7,7 +7,9 @@ use glam::{DVec2, DVec3};
 use super::atmosphere::{Atmosphere, EnvSample};
 use super::config::PhysicsConfig;
 use super::constants::R_D;
+use super::lift::surface_lcl_height;
 use super::parcels::{Life, Parcels, keyed_uniform};
+use super::thermo::saturation_mixing_ratio;
 use super::update::{diagnose, wind_at};
 
 pub(super) fn air_mass(env: &EnvSample, radius_m: f64) -> f64 {
@@ -15,12 +17,30 @@ pub(super) fn air_mass(env: &EnvSample, radius_m: f64) -> f64 {
     rho * 4.0 / 3.0 * std::f64::consts::PI * radius_m.powi(3)
 }
 
+/// The most total water a released parcel may carry, kg/kg: the saturation
+/// mixing ratio where the parcel, lifted dry-adiabatically from the release
+/// height with its `θ_l` excess, reaches the surface air's LCL (the cloud
+/// base). With at most this much water a parcel cannot saturate below the
+/// cloud base, however small the saturation mixing ratio of cold air is
+/// (at -20 °C it is about 0.8 g/kg, less than the default 1 g/kg excess).
+pub(super) fn release_qt_cap(cfg: &PhysicsConfig, atm: &Atmosphere) -> f64 {
+    let z0 = cfg.release_height_m;
+    let theta_l = atm.at(z0).theta_l + cfg.initial_excess_k;
+    let base = surface_lcl_height(atm).unwrap_or(atm.top_m()).max(z0);
+    let e = atm.at(base);
+    // Unsaturated below the base: θ = θ_l, so T = θ_l Π.
+    saturation_mixing_ratio(theta_l * e.exner, e.p_pa)
+}
+
 /// Places parcel `i` for its `generation`-th life: seeded position and
-/// radius, environment air at the release height plus the excess.
+/// radius, environment air at the release height plus the excess, its
+/// total water at most `qt_cap` ([`release_qt_cap`]) unless the
+/// environment there already has more.
 pub(super) fn spawn(
     cfg: &PhysicsConfig,
     atm: &Atmosphere,
     sites: &[DVec2],
+    qt_cap: f64,
     p: &mut Parcels,
     i: usize,
     generation: u32,
@@ -41,7 +61,9 @@ pub(super) fn spawn(
     let w = wind_at(cfg, z);
     p.vel[i] = DVec3::new(w.x, w.y, 0.0);
     p.theta_l[i] = env.theta_l + cfg.initial_excess_k;
-    p.qt[i] = (env.qt + cfg.initial_excess_qt_gkg * 1e-3).max(0.0);
+    p.qt[i] = (env.qt + cfg.initial_excess_qt_gkg * 1e-3)
+        .min(qt_cap.max(env.qt))
+        .max(0.0);
     p.life[i] = Life {
         radius_m: radius,
         mass_kg: air_mass(&env, radius),
