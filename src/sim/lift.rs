@@ -2,14 +2,16 @@
 //! does): the unsaturated adiabat of the moist air to the lifting
 //! condensation level (Romps 2017), then a moist adiabat, either
 //! pseudo-adiabatic (condensate falls out) or reversible (condensate
-//! carried, `θ_l` and `q_t` conserved).
+//! carried: total water and moist entropy conserved, Emanuel 1994).
 
 use serde::{Deserialize, Serialize};
 
 use super::atmosphere::Atmosphere;
 use super::constants::{C_P, EPSILON, G, L_V, R_D, R_V, VIRTUAL_COEFF};
 use super::sounding::Sounding;
-use super::thermo::{dewpoint, exner, saturation_adjust, saturation_mixing_ratio};
+use super::thermo::{
+    dewpoint, latent_heat_at, saturation_mixing_ratio, saturation_vapour_pressure,
+};
 
 /// Which moist adiabat the parcel follows above its LCL.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -33,6 +35,8 @@ pub struct Lcl {
 
 /// Specific heat of water vapour at constant pressure, J/(kg K) (MetPy's).
 const C_PV: f64 = 1_860.078_011_865_639;
+/// Specific heat of liquid water, J/(kg K) (MetPy's).
+const C_L: f64 = 4_219.4;
 
 /// Poisson exponent `R_m / c_pm` of moist air with vapour mixing ratio `qv`
 /// (Romps 2017): the unsaturated adiabat of air that carries its vapour.
@@ -113,6 +117,35 @@ fn pseudo_adiabat_with_step(t: f64, p0: f64, p1: f64, max_step_pa: f64) -> f64 {
         let k4 = pseudo_lapse(t + dp * k3, p + dp);
         t += dp / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
         p += dp;
+    }
+    t
+}
+
+/// Reversible moist entropy per unit mass of dry air of saturated air with
+/// total water `rt` (kg/kg) at `t` (K), `p` (Pa), up to a constant
+/// (Emanuel 1994, Eq. 4.5.9 with H = 1), J/(kg K):
+/// `(c_pd + r_t c_l) ln T - R_d ln(p - e_s) + L_v(T) r_s / T`, with
+/// `L_v(T)` from Kirchhoff's law (as Ambaum's `e_s`).
+pub fn saturated_entropy(t: f64, p: f64, rt: f64) -> f64 {
+    let es = saturation_vapour_pressure(t).min(0.5 * p);
+    let rs = EPSILON * es / (p - es);
+    (C_P + rt * C_L) * t.ln() - R_D * (p - es).ln() + latent_heat_at(t) * rs / t
+}
+
+/// The temperature at which saturated air with total water `rt` at `p` has
+/// the entropy `s` ([`saturated_entropy`]): Newton's method from `guess`
+/// (the entropy rises with T, so it converges from any nearby guess).
+pub fn reversible_temperature(s: f64, rt: f64, p: f64, guess: f64) -> f64 {
+    let mut t = guess;
+    for _ in 0..50 {
+        let h = 1e-3;
+        let f = saturated_entropy(t, p, rt) - s;
+        let slope = (saturated_entropy(t + h, p, rt) - saturated_entropy(t - h, p, rt)) / (2.0 * h);
+        let dt = (f / slope).clamp(-20.0, 20.0);
+        t = (t - dt).max(100.0);
+        if dt.abs() < 1e-9 {
+            break;
+        }
     }
     t
 }
@@ -223,7 +256,10 @@ pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
     } else {
         lcl_height_m
     };
-    let theta_l = t0 / exner(p0) - L_V * (q0 - q0v) / (C_P * exner(p0));
+    // Reversible: the total water and the moist entropy of the air at its
+    // LCL are conserved above it.
+    let s_lcl = saturated_entropy(lcl.temperature_k, lcl.pressure_pa, q0);
+    let mut t_rev = lcl.temperature_k;
     // The pseudo-adiabat is integrated once from the LCL to the top level
     // in RK4 steps of PSEUDO_STEP_PA; each level then reads it by cubic
     // Hermite interpolation (the slope is the lapse rate itself), so the
@@ -248,8 +284,9 @@ pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
                         (t, saturation_mixing_ratio(t, p), 0.0)
                     }
                     Adiabat::Reversible => {
-                        let a = saturation_adjust(theta_l, q0, p, exner(p));
-                        (a.t_k, a.qv, a.qc)
+                        t_rev = reversible_temperature(s_lcl, q0, p, t_rev);
+                        let qv = saturation_mixing_ratio(t_rev, p).min(q0);
+                        (t_rev, qv, q0 - qv)
                     }
                 }
             };
