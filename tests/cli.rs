@@ -532,3 +532,82 @@ fn stats_rejects_a_bad_resolution_before_simulating() {
     assert!(stderr(&o).contains("--resolution is 5"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+#[test]
+fn render_refuses_a_missing_folder_or_a_directory_before_simulating() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = root().join("scenes/fair_weather.toml");
+    let missing = dir.path().join("no/such/folder/sky.png");
+    for (out, says) in [
+        (missing.as_path(), "does not exist"),
+        (dir.path(), "is a directory"),
+    ] {
+        let o = cumulus(&[
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--backend",
+            "cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(1));
+        let err = stderr(&o);
+        assert!(err.contains(says), "{err}");
+        // Refused up front: nothing was simulated or rendered.
+        assert!(
+            !err.contains("backend:") && !err.contains("rendered"),
+            "{err}"
+        );
+    }
+}
+
+/// A successful run prints no "error" (the Wayland probe's XDG_RUNTIME_DIR
+/// complaint was printed twice) and names its backend once.
+#[test]
+fn a_successful_render_prints_no_error_and_one_backend_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sky.png");
+    let scene = root().join("scenes/fair_weather.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args([
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--backend",
+            "auto",
+        ])
+        .args(["--width", "32", "--height", "24", "--time-s", "60", "--out"])
+        .arg(&out)
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(!err.to_lowercase().contains("error"), "{err}");
+    assert_eq!(err.matches("backend:").count(), 1, "{err}");
+}
+
+/// Every command's `--help` ends with an example, and `render --help` says
+/// when `--out` may be left out.
+#[test]
+fn every_help_shows_an_example() {
+    for cmd in [
+        &["simulate"][..],
+        &["profile"],
+        &["convergence"],
+        &["render"],
+        &["bench"],
+        &["stats"],
+        &["scene", "check"],
+    ] {
+        let mut args = cmd.to_vec();
+        args.push("--help");
+        let o = cumulus(&args);
+        assert!(o.status.success(), "{cmd:?}");
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains("Example:\n  cumulus "), "{cmd:?}:\n{text}");
+    }
+    let o = cumulus(&["render", "--help"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("unless --quality-report"));
+}

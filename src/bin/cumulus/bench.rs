@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use crate::{gpu_context, load_scene};
 
 #[derive(clap::Args)]
+#[command(after_help = "Example:\n  cumulus bench --quick --out bench/")]
 pub struct BenchArgs {
     /// Scene every configuration starts from.
     #[arg(long, default_value = "scenes/fair_weather.toml")]

@@ -9,6 +9,9 @@ use cumulus::report::convergence;
 use crate::{load_scene, progress_bar};
 
 #[derive(clap::Args)]
+#[command(
+    after_help = "Example:\n  cumulus convergence --scene scenes/bomex.toml --out convergence/"
+)]
 pub struct ConvergenceArgs {
     /// Scene TOML file.
     #[arg(long)]

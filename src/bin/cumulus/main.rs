@@ -63,6 +63,7 @@ enum Command {
 #[derive(Subcommand)]
 enum SceneCommand {
     /// Validate a scene (and its sounding); report errors with file, line and key.
+    #[command(after_help = "Example:\n  cumulus scene check scenes/bomex.toml")]
     Check {
         /// Scene TOML file.
         file: PathBuf,
@@ -70,6 +71,7 @@ enum SceneCommand {
 }
 
 fn main() {
+    quiet_wayland_probe();
     if let Err(e) = run(Cli::parse()) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
@@ -135,6 +137,43 @@ fn finite_positive(name: &str, v: f64) -> Result<()> {
 
 fn load_scene(path: &Path) -> Result<Scene> {
     Ok(Scene::load(path)?)
+}
+
+/// The GPU probe loads the Vulkan drivers' window-system code, whose
+/// Wayland client prints "error: XDG_RUNTIME_DIR is invalid or not set"
+/// when that variable is missing, on runs that then succeed. The command
+/// line opens no window, so it gives the probe an absolute (empty) runtime
+/// directory: the Wayland connection fails quietly and nothing else
+/// changes. Runs first in `main`, before any thread exists.
+fn quiet_wayland_probe() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // SAFETY: single-threaded here (the first statement of main); no
+        // other code reads or writes the environment concurrently.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
+}
+
+/// Fails early, before any simulation, when `path` cannot be written: it is
+/// a directory, or its folder does not exist.
+fn check_output_file(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        bail!(
+            "{}: is a directory, expected a file to write",
+            path.display()
+        );
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        bail!(
+            "{}: cannot write: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// The scene with the flags that override its keys applied, validated

@@ -10,6 +10,9 @@ use cumulus::sim::Sounding;
 use cumulus::sim::lift::{Adiabat, lift_sounding};
 
 #[derive(clap::Args)]
+#[command(
+    after_help = "Example:\n  cumulus profile --sounding scenes/bomex_sounding.csv --adiabat reversible --out profile.csv"
+)]
 pub struct ProfileArgs {
     /// Sounding CSV (height_m,pressure_hPa,temperature_C,dewpoint_C).
     #[arg(long)]

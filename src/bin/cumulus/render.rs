@@ -10,14 +10,18 @@ use cumulus::prepare::Prepared;
 use cumulus::render::gpu::GpuContext;
 use cumulus::scene::Scene;
 
-use crate::{gpu_context, load_scene, progress_bar, with_overrides};
+use crate::{check_output_file, gpu_context, load_scene, progress_bar, with_overrides};
 
 #[derive(clap::Args)]
+#[command(
+    after_help = "Example:\n  cumulus render --scene scenes/fair_weather.toml --out sky.png\n  cumulus render --scene scenes/evening.toml --backend gpu --time-frames 100 --out evening.png"
+)]
 pub struct RenderArgs {
     /// Scene TOML file.
     #[arg(long)]
     scene: PathBuf,
-    /// Output PNG (written atomically).
+    /// Output PNG (written atomically). Needed unless --quality-report is
+    /// given.
     #[arg(long, required_unless_present = "quality_report")]
     out: Option<PathBuf>,
     /// Also write the error-against-cost report (render_quality.csv/.png)
@@ -81,20 +85,26 @@ pub fn run(a: RenderArgs) -> Result<()> {
             r.steps = steps;
         }
     })?;
+    if let Some(out) = &a.out {
+        check_output_file(out)?;
+    }
     let gpu = match a.backend {
-        Backend::Cpu => None,
+        Backend::Cpu => {
+            eprintln!("backend: cpu (the CPU reference renderer)");
+            None
+        }
         Backend::Gpu => Some(gpu_context().context("--backend gpu")?),
         Backend::Auto => match gpu_context() {
             Ok(c) if c.adapter_info.device_type != wgpu::DeviceType::Cpu => Some(c),
             Ok(c) => {
                 eprintln!(
-                    "backend: cpu (the only GPU adapter is software, {}; --backend gpu uses it)",
+                    "backend: cpu (the CPU reference renderer; the only GPU adapter is software, {}; --backend gpu uses it)",
                     c.adapter_info.name
                 );
                 None
             }
             Err(e) => {
-                eprintln!("backend: cpu ({e})");
+                eprintln!("backend: cpu (the CPU reference renderer; {e})");
                 None
             }
         },
@@ -149,7 +159,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(ctx) = &gpu {
         return render_gpu(ctx, &a, &scene, &prepared);
     }
-    eprintln!("backend: cpu (the CPU reference renderer)");
     let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
     let linear = render_linear(r.width, r.height, &frame);

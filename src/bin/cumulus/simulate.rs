@@ -11,6 +11,9 @@ use cumulus::sim::{FramePlan, Simulation};
 use crate::{finite_positive, load_scene, progress_bar, with_overrides};
 
 #[derive(clap::Args)]
+#[command(
+    after_help = "Example:\n  cumulus simulate --scene scenes/bomex.toml --duration-s 3600 --out curves.csv"
+)]
 pub struct SimulateArgs {
     /// Scene TOML file.
     #[arg(long)]
