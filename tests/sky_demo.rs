@@ -75,6 +75,12 @@ fn screenshot_shows_sky_and_clouds_in_a_real_window() {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     );
+    // --screenshot says how far it has got.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("frame 1 of 3") && err.contains("frame 3 of 3"),
+        "{err}"
+    );
     let img = image::open(&shot).expect("a PNG").to_rgb8();
     assert_eq!(img.dimensions(), (800, 450));
     // Right of the control panel (about 300 px), the upper two thirds are

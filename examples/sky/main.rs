@@ -200,7 +200,11 @@ impl App {
                 egui::Panel::left("controls")
                     .default_size(300.0)
                     .show(ui, |ui| {
-                        actions = ui::panel(ui, world, camera, views, scenes, message, save_path);
+                        // Scrolls when the window is shorter than the panel.
+                        egui::ScrollArea::vertical().show(ui, |ui| {
+                            actions =
+                                ui::panel(ui, world, camera, views, scenes, message, save_path);
+                        });
                     });
             }
             ui::debug_views(ui.ctx(), world, views);
@@ -344,6 +348,9 @@ impl App {
         window.pre_present_notify();
         g.ctx.queue.present(frame);
         self.frames_done += 1;
+        if screenshot {
+            eprintln!("frame {} of {}", self.frames_done, self.args.frames);
+        }
         if last {
             event_loop.exit();
         }
