@@ -60,6 +60,10 @@ pub struct RenderSettings {
     pub tsaa: bool,
     /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
     pub tsaa_blend: f32,
+    /// CPU pictures: marches per pixel, their samples shifted by `k / n`
+    /// of a step, averaged (1..=64; 1 shows the fixed dither's fine
+    /// checker at 48 steps). Default 4.
+    pub cpu_offsets: u32,
     /// The cloud map (`[render.cloud_map]`).
     pub cloud_map: CloudMapConfig,
     /// The terrain (`[render.terrain]`), off by default.
@@ -90,6 +94,7 @@ impl Default for RenderSettings {
             time_s: 2400.0,
             tsaa: true,
             tsaa_blend: 0.1,
+            cpu_offsets: 4,
             cloud_map: Default::default(),
             terrain: TerrainConfig::default(),
         }
@@ -192,6 +197,12 @@ impl RenderSettings {
             range("render.exposure", f(r.exposure), 1e-3, 1e3, "> 0"),
             range("render.time_s", r.time_s, 0.0, 1e7, "0..=1e7 s"),
             range("render.tsaa_blend", f(r.tsaa_blend), 1e-3, 1.0, "0.001..=1"),
+            Check::new(
+                "render.cpu_offsets",
+                (1..=64).contains(&r.cpu_offsets),
+                "1..=64",
+                r.cpu_offsets as f64,
+            ),
             Check::new(
                 "render.cloud_map.size",
                 (16..=2048).contains(&r.cloud_map.size),

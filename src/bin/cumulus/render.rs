@@ -66,7 +66,7 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::renderer::{render_linear, to_srgb8};
+    use cumulus::render::cpu::renderer::{render_linear_offsets, to_srgb8};
     use cumulus::report::render_quality;
 
     let flags = "--width/--height/--time-s/--steps";
@@ -161,7 +161,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
-    let linear = render_linear(r.width, r.height, &frame);
+    let linear = render_linear_offsets(r.width, r.height, &frame, r.cpu_offsets);
     let elapsed = start.elapsed();
     let bytes = to_srgb8(&linear, r.exposure);
     let img = image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
