@@ -611,3 +611,135 @@ fn every_help_shows_an_example() {
     let o = cumulus(&["render", "--help"]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("unless --quality-report"));
 }
+
+/// Errors say where the bad value came from, once.
+#[test]
+fn errors_name_where_the_value_came_from() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    // A missing scene: the OS error once.
+    let o = cumulus(&["scene", "check", "nothere.toml"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        stderr(&o).matches("No such file").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
+    // A missing sounding: the scene file, line and key that name it.
+    let s = write(
+        "s1.toml",
+        "name = \"x\"\n[atmosphere]\nsounding = \"missing.csv\"\n",
+    );
+    let o = cumulus(&["scene", "check", s.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(
+        err.contains("s1.toml:3: `atmosphere.sounding`: names") && err.contains("missing.csv"),
+        "{err}"
+    );
+    // A flag's value: the flag, not a line of the scene.
+    let s = write("s2.toml", "[physics]\nparcels = 12\n");
+    let out = dir.path().join("c.csv");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        s.to_str().unwrap(),
+        "--parcels",
+        "10000000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert!(
+        err.contains("--parcels is 10000000, expected 0..=200000"),
+        "{err}"
+    );
+    assert!(!err.contains("s2.toml:2"), "{err}");
+    // A TOML type error: the key.
+    let s = write("s3.toml", "[physics]\nparcels = \"many\"\n");
+    let o = cumulus(&["scene", "check", s.to_str().unwrap()]);
+    assert!(
+        stderr(&o).contains("s3.toml:2:11: `physics.parcels`: invalid type"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn odd_values_get_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let scene = root().join("scenes/fair_weather.toml");
+    let sc = scene.to_str().unwrap();
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        sc,
+        "--width",
+        "-5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("invalid value '-5' for '--width"),
+        "{}",
+        stderr(&o)
+    );
+    // A camera so far away that nothing could be drawn.
+    let far = dir.path().join("far.toml");
+    std::fs::write(&far, "[render]\ncamera_position_m = [0, 1e9, 0]\n").unwrap();
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        far.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("`render.camera_position_m`"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    // A duration with no bound.
+    let csv = dir.path().join("c.csv");
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        sc,
+        "--duration-s",
+        "1e15",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("--duration-s is 1000000000000000"),
+        "{}",
+        stderr(&o)
+    );
+    // Off a terminal, a run reports its progress in plain lines.
+    let o = cumulus(&[
+        "simulate",
+        "--scene",
+        sc,
+        "--parcels",
+        "3",
+        "--duration-s",
+        "600",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("simulating: 50 % (60 of 120)") && err.contains("simulating: 100 %"),
+        "{err}"
+    );
+}

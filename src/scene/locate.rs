@@ -36,6 +36,31 @@ pub fn locate_key(text: &str, key: &str) -> Option<usize> {
     None
 }
 
+/// The dotted key assigned on 1-based `line` of TOML text (its table
+/// header, then the left-hand side), if that line assigns one.
+pub(super) fn key_at_line(text: &str, line: usize) -> Option<String> {
+    let mut table: Vec<String> = Vec::new();
+    for (n, raw) in text.lines().enumerate() {
+        let l = raw.trim();
+        if let Some(h) = l.strip_prefix('[') {
+            let h = h.trim_start_matches('[').split(']').next().unwrap_or("");
+            table = h.split('.').map(|s| s.trim().to_owned()).collect();
+        } else if n + 1 == line {
+            let (lhs, _) = l.split_once('=')?;
+            let mut full = table.clone();
+            full.extend(
+                lhs.split('.')
+                    .map(|s| s.trim().trim_matches('"').to_owned()),
+            );
+            return Some(full.join("."));
+        }
+        if n + 1 >= line {
+            break;
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -47,5 +72,10 @@ mod tests {
         assert_eq!(locate_key(t, "physics.sph.sound_speed_mps"), Some(4));
         assert_eq!(locate_key(t, "physics.wind.speed_mps"), Some(6));
         assert_eq!(locate_key(t, "physics.radius_m"), None);
+        assert_eq!(
+            key_at_line(t, 4).as_deref(),
+            Some("physics.sph.sound_speed_mps")
+        );
+        assert_eq!(key_at_line(t, 2), None);
     }
 }

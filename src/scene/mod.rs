@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 pub use atmosphere::AtmosphereSection;
-use locate::line_col;
 pub use locate::locate_key;
+use locate::{key_at_line, line_col};
 pub use projection::ProjectionSection;
 pub use render::RenderSettings;
 
@@ -25,11 +25,12 @@ use crate::sim::{Atmosphere, Band, PhysicsConfig, Sounding, SoundingError};
 /// What went wrong with a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{path}: cannot read scene: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    // The OS error is part of the message, not a `source`, so a report
+    // that prints the error chain does not print it twice.
+    #[error("{path}: cannot read scene: {err}")]
+    Io { path: PathBuf, err: std::io::Error },
+    #[error("{path}: cannot write scene: {err}")]
+    Write { path: PathBuf, err: std::io::Error },
     #[error("{path}:{line}:{column}: {message}")]
     Parse {
         path: PathBuf,
@@ -70,9 +71,9 @@ pub struct Scene {
 impl Scene {
     /// Reads, parses and validates a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        let text = std::fs::read_to_string(path).map_err(|err| SceneError::Io {
             path: path.to_owned(),
-            source,
+            err,
         })?;
         Self::parse(&text, path)
     }
@@ -82,11 +83,18 @@ impl Scene {
     pub fn parse(text: &str, path: &Path) -> Result<Self, SceneError> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
+            let message = e.message().trim();
+            // A type error names the key it is about (an unknown key's
+            // message names the key already).
+            let message = match key_at_line(text, line) {
+                Some(key) if !message.contains("unknown field") => format!("`{key}`: {message}"),
+                _ => message.to_owned(),
+            };
             SceneError::Parse {
                 path: path.to_owned(),
                 line,
                 column,
-                message: e.message().trim().to_owned(),
+                message,
             }
         })?;
         scene.source = Some(path.to_owned());
@@ -155,10 +163,10 @@ impl Scene {
     /// back with the same settings ([`Self::same_settings`]).
     pub fn save(&self, path: &Path) -> Result<(), SceneError> {
         let text = self.to_toml(path)?;
-        crate::io::write_atomically(path, |out| out.write_all(text.as_bytes())).map_err(|source| {
-            SceneError::Io {
+        crate::io::write_atomically(path, |out| out.write_all(text.as_bytes())).map_err(|err| {
+            SceneError::Write {
                 path: path.to_owned(),
-                source,
+                err,
             }
         })
     }
@@ -196,7 +204,14 @@ impl Scene {
         };
         let atm = match sounding_path {
             Some(p) => {
-                let s = Sounding::load(&p, surface)?;
+                let s = Sounding::load(&p, surface).map_err(|e| match e {
+                    // A file that cannot be read: say which key named it.
+                    SoundingError::Io { path, err } if sounding_override.is_none() => self.invalid(
+                        "atmosphere.sounding",
+                        format!("names {}: cannot read sounding: {err}", path.display()),
+                    ),
+                    e => e.into(),
+                })?;
                 Atmosphere::from_sounding(&s)
             }
             None => Atmosphere::from_parametric(&a.parametric.unwrap_or_default()),

@@ -101,6 +101,9 @@ impl Default for RenderSettings {
     }
 }
 
+/// How far the camera may be from the origin horizontally, m.
+const CAMERA_REACH_M: f32 = 1e6;
+
 impl RenderSettings {
     /// Every key against its domain.
     pub fn checks(&self) -> Vec<Check> {
@@ -124,6 +127,23 @@ impl RenderSettings {
                 "render.camera_position_m",
                 r.camera_position_m.iter().all(|x| x.is_finite()),
                 "three finite numbers [x, y, z] in m",
+                f(r.camera_position_m[1]),
+            ),
+            // Beyond this the f32 ray maths loses the cloud band (a camera
+            // at 1e9 m drew a black picture).
+            Check::new(
+                "render.camera_position_m",
+                r.camera_position_m[0].abs() <= CAMERA_REACH_M
+                    && r.camera_position_m[2].abs() <= CAMERA_REACH_M,
+                "x and z within ±1e6 m",
+                f(r.camera_position_m[0]
+                    .abs()
+                    .max(r.camera_position_m[2].abs())),
+            ),
+            Check::new(
+                "render.camera_position_m",
+                (-1e3..=1e5).contains(&r.camera_position_m[1]),
+                "a height y within -1000..=100000 m",
                 f(r.camera_position_m[1]),
             ),
             Check::new(

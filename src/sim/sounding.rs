@@ -15,11 +15,10 @@ use super::thermo::{mixing_ratio_from_dewpoint, saturation_mixing_ratio};
 /// where there is one, the line and column.
 #[derive(Debug, thiserror::Error)]
 pub enum SoundingError {
-    #[error("{path}: cannot read sounding: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    // The OS error is part of the message, not a `source`, so a report
+    // that prints the error chain does not print it twice.
+    #[error("{path}: cannot read sounding: {err}")]
+    Io { path: PathBuf, err: std::io::Error },
     #[error("{path}:{line}: {message}")]
     Invalid {
         path: PathBuf,
@@ -57,9 +56,9 @@ impl Sounding {
     /// Reads and validates a sounding file. `surface_pressure_pa` anchors the
     /// hydrostatic integration when no row gives a pressure.
     pub fn load(path: &Path, surface_pressure_pa: f64) -> Result<Self, SoundingError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SoundingError::Io {
+        let text = std::fs::read_to_string(path).map_err(|err| SoundingError::Io {
             path: path.to_owned(),
-            source,
+            err,
         })?;
         Self::parse(&text, path, surface_pressure_pa)
     }

@@ -16,7 +16,8 @@ pub struct ConvergenceArgs {
     /// Scene TOML file.
     #[arg(long)]
     scene: PathBuf,
-    /// Simulated time per run, seconds (a multiple of 600).
+    /// Simulated time per run, seconds (at least 600: the runs are compared
+    /// every 600 s).
     #[arg(long, default_value_t = 1800.0)]
     duration_s: f64,
     /// Output directory (created if missing).
@@ -26,11 +27,12 @@ pub struct ConvergenceArgs {
 
 pub fn run(a: ConvergenceArgs) -> Result<()> {
     let scene = load_scene(&a.scene)?;
-    if !(a.duration_s >= convergence::COMPARE_EVERY_S && a.duration_s.is_finite()) {
+    if !(a.duration_s >= convergence::COMPARE_EVERY_S && a.duration_s <= crate::MAX_DURATION_S) {
         bail!(
-            "--duration-s is {}, expected at least {} s",
+            "--duration-s is {}, expected {}..={:e} s",
             a.duration_s,
-            convergence::COMPARE_EVERY_S
+            convergence::COMPARE_EVERY_S,
+            crate::MAX_DURATION_S
         );
     }
     let atm = scene.atmosphere(None)?;

@@ -36,22 +36,28 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Simulate a scene and write the parcel curves (paper's Fig. 5) as CSV.
+    #[command(allow_negative_numbers = true)]
     Simulate(simulate::SimulateArgs),
     /// Lift the sounding's lowest air without mixing (like MetPy's
     /// parcel_profile): print its LCL, write one row per level.
+    #[command(allow_negative_numbers = true)]
     Profile(profile::ProfileArgs),
     /// Error against run time: run a scene at steps from 0.1 s to 600 s
     /// against a fine reference; write convergence.csv and convergence.png.
+    #[command(allow_negative_numbers = true)]
     Convergence(convergence::ConvergenceArgs),
     /// Simulate a scene, then render one sky image (PNG) of its clouds.
+    #[command(allow_negative_numbers = true)]
     Render(render::RenderArgs),
     /// GPU frame benchmarks: resolution, coverage, parcel count (cloud map
     /// against a per-parcel baseline), features, the physics' share of the
     /// frame, and render error against GPU time. Writes CSV, JSON and PNGs.
+    #[command(allow_negative_numbers = true)]
     Bench(bench::BenchArgs),
     /// Statistics of the cloud field seen from above: cloud fraction and
     /// its profile by height, the area-perimeter fractal dimension, the
     /// cloud-size density and its power-law exponent (CSV, JSON, plots).
+    #[command(allow_negative_numbers = true)]
     Stats(stats::StatsArgs),
     /// Scene files.
     Scene {
@@ -110,10 +116,41 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
-fn progress_bar(len: u64, what: &str) -> ProgressBar {
+/// Progress of a long run: a bar on a terminal; elsewhere (a log, CI, a
+/// pipe) a plain line on stderr at every tenth of the work, so a long run
+/// shows it is alive.
+pub struct Progress {
+    bar: ProgressBar,
+    /// Without a terminal: what, the total and the units done.
+    plain: Option<(String, u64, std::cell::Cell<u64>)>,
+}
+
+impl Progress {
+    /// One more unit of work (`n` units).
+    pub fn inc(&self, n: u64) {
+        self.bar.inc(n);
+        if let Some((what, len, done)) = &self.plain {
+            let before = done.get();
+            let after = before + n;
+            done.set(after);
+            let tenth = |k: u64| k * 10 / (*len).max(1);
+            if tenth(after) > tenth(before) {
+                eprintln!("{what}: {} % ({after} of {len})", tenth(after).min(10) * 10);
+            }
+        }
+    }
+
+    /// Clears the bar (the plain lines stay).
+    pub fn finish_and_clear(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+fn progress_bar(len: u64, what: &str) -> Progress {
+    let terminal = std::io::stderr().is_terminal();
     let bar = ProgressBar::with_draw_target(
         Some(len),
-        if std::io::stderr().is_terminal() {
+        if terminal {
             ProgressDrawTarget::stderr()
         } else {
             ProgressDrawTarget::hidden()
@@ -125,12 +162,18 @@ fn progress_bar(len: u64, what: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar.set_message(what.to_owned());
-    bar
+    Progress {
+        bar,
+        plain: (!terminal).then(|| (what.to_owned(), len, std::cell::Cell::new(0))),
+    }
 }
 
+/// The longest run a flag may ask for, s (as `render.time_s`): 116 days.
+const MAX_DURATION_S: f64 = 1e7;
+
 fn finite_positive(name: &str, v: f64) -> Result<()> {
-    if !(v.is_finite() && v > 0.0) {
-        bail!("{name} is {v}, expected a positive number of seconds");
+    if !(v.is_finite() && v > 0.0 && v <= MAX_DURATION_S) {
+        bail!("{name} is {v}, expected a positive number of seconds, at most {MAX_DURATION_S:e}");
     }
     Ok(())
 }
@@ -177,13 +220,27 @@ fn check_output_file(path: &Path) -> Result<()> {
 }
 
 /// The scene with the flags that override its keys applied, validated
-/// again (a flag's bad value is reported like a bad key, naming `flags`).
-fn with_overrides(mut scene: Scene, flags: &str, apply: impl FnOnce(&mut Scene)) -> Result<Scene> {
+/// again. `flags` pairs each flag with the key it sets: a bad value is
+/// blamed on the flag that gave it, not on a line of the scene file.
+fn with_overrides(
+    mut scene: Scene,
+    flags: &[(&str, &str)],
+    apply: impl FnOnce(&mut Scene),
+) -> Result<Scene> {
     apply(&mut scene);
-    scene
-        .validate()
-        .with_context(|| format!("after applying {flags}"))?;
-    Ok(scene)
+    match scene.validate() {
+        Ok(()) => Ok(scene),
+        Err(cumulus::scene::SceneError::Invalid { key, message, .. })
+            if flags.iter().any(|(_, k)| *k == key) =>
+        {
+            let flag = flags.iter().find(|(_, k)| *k == key).map_or("", |f| f.0);
+            bail!("{flag} {message} (it sets {key})")
+        }
+        Err(e) => {
+            let names: Vec<&str> = flags.iter().map(|f| f.0).collect();
+            Err(e).with_context(|| format!("after applying {}", names.join("/")))
+        }
+    }
 }
 
 /// The GPU, from `WGPU_BACKEND` when set (the binary's edge reads the

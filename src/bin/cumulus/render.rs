@@ -69,8 +69,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
     use cumulus::render::cpu::renderer::{render_linear_offsets, to_srgb8};
     use cumulus::report::render_quality;
 
-    let flags = "--width/--height/--time-s/--steps";
-    let scene = with_overrides(load_scene(&a.scene)?, flags, |s| {
+    let flags = [
+        ("--width", "render.width"),
+        ("--height", "render.height"),
+        ("--time-s", "render.time_s"),
+        ("--steps", "render.steps"),
+    ];
+    let scene = with_overrides(load_scene(&a.scene)?, &flags, |s| {
         let r = &mut s.render;
         if let Some(w) = a.width {
             r.width = w;
@@ -98,13 +103,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
             Ok(c) if c.adapter_info.device_type != wgpu::DeviceType::Cpu => Some(c),
             Ok(c) => {
                 eprintln!(
-                    "backend: cpu (the CPU reference renderer; the only GPU adapter is software, {}; --backend gpu uses it)",
+                    "backend: cpu (the only GPU adapter is software, {}; --backend gpu uses it)",
                     c.adapter_info.name
                 );
                 None
             }
             Err(e) => {
-                eprintln!("backend: cpu (the CPU reference renderer; {e})");
+                eprintln!("backend: cpu ({e}; the CPU reference renderer)");
                 None
             }
         },

@@ -43,7 +43,12 @@ pub struct SimulateArgs {
 }
 
 pub fn run(a: SimulateArgs) -> Result<()> {
-    let scene = with_overrides(load_scene(&a.scene)?, "--dt-s/--parcels/--seed", |s| {
+    let flags = [
+        ("--dt-s", "physics.dt_s"),
+        ("--parcels", "physics.parcels"),
+        ("--seed", "physics.seed"),
+    ];
+    let scene = with_overrides(load_scene(&a.scene)?, &flags, |s| {
         if let Some(dt) = a.dt_s {
             s.physics.dt_s = dt;
         }

@@ -53,7 +53,8 @@ pub fn run(a: StatsArgs) -> Result<()> {
             a.tau_min
         );
     }
-    let scene = with_overrides(load_scene(&a.scene)?, "--time-s", |s| {
+    let flags = [("--time-s", "render.time_s")];
+    let scene = with_overrides(load_scene(&a.scene)?, &flags, |s| {
         if let Some(t) = a.time_s {
             s.render.time_s = t;
         }
