@@ -743,3 +743,48 @@ fn odd_values_get_clear_errors() {
         "{err}"
     );
 }
+
+/// SIGINT and SIGTERM remove the run's temporary file (it used to stay,
+/// up to 50 MB, as `.NAME.PID.tmp`); a later run into the same folder
+/// removes the ones that runs which are gone (SIGKILL) left.
+#[test]
+fn interrupted_runs_leave_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = root().join("scenes/fair_weather.toml");
+    let out = dir.path().join("curves.csv");
+    let stale = dir.path().join(format!(".curves.csv.{}.tmp", u32::MAX));
+    std::fs::write(&stale, "left by a killed run").unwrap();
+    for signal in ["-INT", "-TERM"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_cumulus"))
+            .args(["simulate", "--scene", scene.to_str().unwrap()])
+            .args(["--parcels", "400", "--duration-s", "1e6", "--out"])
+            .arg(&out)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("runs");
+        let tmp = dir.path().join(format!(".curves.csv.{}.tmp", child.id()));
+        let start = std::time::Instant::now();
+        while !tmp.exists() {
+            assert!(
+                start.elapsed().as_secs() < 120,
+                "no temporary file appeared"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        if std::path::Path::new("/proc/self").exists() {
+            assert!(
+                !stale.exists(),
+                "the stale file of a gone process was not removed"
+            );
+        }
+        let kill = Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(kill.success());
+        let status = child.wait().expect("exits");
+        assert_eq!(status.code(), Some(130), "{signal}");
+        assert!(!tmp.exists(), "{signal}: {} left behind", tmp.display());
+        assert!(!out.exists());
+    }
+}

@@ -48,6 +48,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    crate::guard_output_dir(&a.out);
     let report = gpu_bench::run(&ctx, &scene, &o, |line| eprintln!("{line}"))?;
     gpu_bench::write(&report, &a.out)?;
     println!(

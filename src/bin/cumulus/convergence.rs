@@ -38,6 +38,7 @@ pub fn run(a: ConvergenceArgs) -> Result<()> {
     let atm = scene.atmosphere(None)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    crate::guard_output_dir(&a.out);
     let dts = convergence::DEFAULT_DTS_S;
     let bar = progress_bar(dts.len() as u64 + 1, "convergence");
     let report = convergence::measure(&scene.physics, &atm, a.duration_s, &dts, || bar.inc(1));

@@ -78,6 +78,7 @@ enum SceneCommand {
 
 fn main() {
     quiet_wayland_probe();
+    install_interrupt_handler();
     if let Err(e) = run(Cli::parse()) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
@@ -193,6 +194,48 @@ fn quiet_wayland_probe() {
         // SAFETY: single-threaded here (the first statement of main); no
         // other code reads or writes the environment concurrently.
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
+}
+
+/// The folders this run writes into: on SIGINT or SIGTERM the run's own
+/// temporary files there are removed before it exits. (SIGKILL cannot be
+/// caught; the next run into the same folder removes what it left.)
+static OUTPUT_DIRS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn install_interrupt_handler() {
+    let handler = || {
+        if let Ok(dirs) = OUTPUT_DIRS.lock() {
+            for d in dirs.iter() {
+                cumulus::io::remove_temp_files(d, Some(std::process::id()));
+            }
+        }
+        eprintln!("interrupted: no output written");
+        std::process::exit(130);
+    };
+    if let Err(e) = ctrlc::set_handler(handler) {
+        eprintln!(
+            "warning: cannot catch interrupts ({e}); an interrupted run may leave a .NAME.PID.tmp file"
+        );
+    }
+}
+
+/// Registers the folder `dir` that this run writes into (see
+/// [`OUTPUT_DIRS`]) and removes the temporary files that runs which are gone
+/// left there.
+fn guard_output_dir(dir: &Path) {
+    for f in cumulus::io::remove_temp_files(dir, None) {
+        eprintln!("removed {} (left by an interrupted run)", f.display());
+    }
+    if let Ok(mut dirs) = OUTPUT_DIRS.lock() {
+        dirs.push(dir.to_owned());
+    }
+}
+
+/// [`guard_output_dir`] for the folder of the output file `path`.
+fn guard_output_file(path: &Path) {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => guard_output_dir(d),
+        _ => guard_output_dir(Path::new(".")),
     }
 }
 

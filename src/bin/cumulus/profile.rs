@@ -57,6 +57,7 @@ pub fn run(a: ProfileArgs) -> Result<()> {
         None => println!("lcl_height_m=none (the parcel does not saturate within the sounding)"),
     }
     if let Some(out) = &a.out {
+        crate::guard_output_file(out);
         write_atomically(out, |w| {
             writeln!(
                 w,

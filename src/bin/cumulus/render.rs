@@ -10,7 +10,10 @@ use cumulus::prepare::Prepared;
 use cumulus::render::gpu::GpuContext;
 use cumulus::scene::Scene;
 
-use crate::{check_output_file, gpu_context, load_scene, progress_bar, with_overrides};
+use crate::{
+    check_output_file, gpu_context, guard_output_dir, guard_output_file, load_scene, progress_bar,
+    with_overrides,
+};
 
 #[derive(clap::Args)]
 #[command(
@@ -92,6 +95,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     })?;
     if let Some(out) = &a.out {
         check_output_file(out)?;
+        guard_output_file(out);
     }
     let gpu = match a.backend {
         Backend::Cpu => {
@@ -125,6 +129,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(dir) = &a.quality_report {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+        guard_output_dir(dir);
         let (w, h) = (r.width.min(320), r.height.min(240));
         let bar = progress_bar(render_quality::STEPS.len() as u64 + 1, "rendering");
         let report = render_quality::measure(&frame, w, h, &render_quality::STEPS, || bar.inc(1));

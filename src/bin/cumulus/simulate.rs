@@ -8,7 +8,7 @@ use cumulus::io::write_atomically;
 use cumulus::report::curves;
 use cumulus::sim::{FramePlan, Simulation};
 
-use crate::{finite_positive, load_scene, progress_bar, with_overrides};
+use crate::{finite_positive, guard_output_file, load_scene, progress_bar, with_overrides};
 
 #[derive(clap::Args)]
 #[command(
@@ -63,6 +63,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let every = a.every_s.unwrap_or(scene.physics.dt_s);
     finite_positive("--every-s", every)?;
     let atm = scene.atmosphere(a.sounding.as_deref())?;
+    guard_output_file(&a.out);
     let band = scene.band(&atm);
     // Exactly the duration asked: a short last frame when dt does not
     // divide it.

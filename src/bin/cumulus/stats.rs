@@ -61,6 +61,7 @@ pub fn run(a: StatsArgs) -> Result<()> {
     })?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    crate::guard_output_dir(&a.out);
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
