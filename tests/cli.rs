@@ -788,3 +788,39 @@ fn interrupted_runs_leave_no_temporary_file() {
         assert!(!out.exists());
     }
 }
+
+/// Run outside the repository, the default scene paths (`bench`'s
+/// `scenes/fair_weather.toml`, the sky demo's `scenes/evening.toml`) fall
+/// back to the scenes built into the binary, and say so.
+#[test]
+fn shipped_scenes_work_outside_the_repository() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |scene: &str| {
+        Command::new(env!("CARGO_BIN_EXE_cumulus"))
+            .args([
+                "render",
+                "--scene",
+                scene,
+                "--backend",
+                "cpu",
+                "--out",
+                "sky.png",
+            ])
+            .args(["--width", "16", "--height", "12", "--time-s", "10"])
+            .current_dir(dir.path())
+            .output()
+            .expect("runs")
+    };
+    let o = render("scenes/fair_weather.toml");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("using the built-in copy"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(dir.path().join("sky.png").is_file());
+    // Not a shipped scene's name: the usual error.
+    let o = render("scenes/mine.toml");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("cannot read scene"), "{}", stderr(&o));
+}

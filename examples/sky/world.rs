@@ -55,7 +55,13 @@ pub const SPIN_UP_S: f64 = 1200.0;
 impl World {
     /// Loads `path` and spins its sky up.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let scene = Scene::load(path)?;
+        let (scene, builtin) = Scene::load_or_builtin(path)?;
+        if builtin {
+            eprintln!(
+                "{}: not found here; using the built-in copy (pass --scene PATH for another scene)",
+                path.display()
+            );
+        }
         Self::from_scene(scene, path.to_owned())
     }
 

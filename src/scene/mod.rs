@@ -68,7 +68,47 @@ pub struct Scene {
     text: Option<String>,
 }
 
+/// The shipped scenes that need no other file, built into the library so
+/// the tools also run outside the repository (BOMEX needs its sounding CSV
+/// and is not among them).
+pub const BUILTIN: &[(&str, &str)] = &[
+    (
+        "fair_weather.toml",
+        include_str!("../../scenes/fair_weather.toml"),
+    ),
+    ("evening.toml", include_str!("../../scenes/evening.toml")),
+    (
+        "strong_inversion.toml",
+        include_str!("../../scenes/strong_inversion.toml"),
+    ),
+];
+
 impl Scene {
+    /// The built-in copy of the shipped scene named `file_name` (e.g.
+    /// `fair_weather.toml`), if there is one.
+    pub fn builtin(file_name: &str) -> Option<Result<Self, SceneError>> {
+        BUILTIN
+            .iter()
+            .find(|(n, _)| *n == file_name)
+            .map(|(n, text)| Self::parse(text, Path::new(&format!("(built-in) scenes/{n}"))))
+    }
+
+    /// [`Self::load`], except that when there is no file at `path` and its
+    /// name is that of a built-in scene (a tool run outside the repository
+    /// with a default `scenes/NAME.toml`), the built-in copy; the flag says
+    /// which it was.
+    pub fn load_or_builtin(path: &Path) -> Result<(Self, bool), SceneError> {
+        if !path.exists()
+            && let Some(b) = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .and_then(Self::builtin)
+        {
+            return Ok((b?, true));
+        }
+        Ok((Self::load(path)?, false))
+    }
+
     /// Reads, parses and validates a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|err| SceneError::Io {

@@ -179,8 +179,17 @@ fn finite_positive(name: &str, v: f64) -> Result<()> {
     Ok(())
 }
 
+/// The scene at `path` ([`Scene::load_or_builtin`]: outside the
+/// repository a shipped scene's built-in copy, said so).
 fn load_scene(path: &Path) -> Result<Scene> {
-    Ok(Scene::load(path)?)
+    let (scene, builtin) = Scene::load_or_builtin(path)?;
+    if builtin {
+        eprintln!(
+            "{}: not found here; using the built-in copy (pass --scene PATH for another scene)",
+            path.display()
+        );
+    }
+    Ok(scene)
 }
 
 /// The GPU probe loads the Vulkan drivers' window-system code, whose
