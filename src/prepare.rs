@@ -10,7 +10,7 @@ use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::density::{DensityParams, Fields};
 use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::gpu::baseline::Sphere;
-use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless, TsaaSettings};
+use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless};
 use crate::render::terrain::Heightfield;
 use crate::scene::{RenderSettings, Scene, SceneError};
 use crate::sim::{Band, FramePlan, Parcels, ProjectedField, Simulation};
@@ -121,37 +121,20 @@ pub fn spawn_sites(cloud_map: &CloudMap, extent_m: f64) -> Vec<DVec2> {
 }
 
 /// The density's parameters for `[render]` settings `r`, a cloud band and
-/// the map's extent (the physics domain).
+/// the map's extent ([`RenderSettings::density`]).
 pub fn density_params(r: &RenderSettings, band: Band, map_extent_m: f64) -> DensityParams {
-    DensityParams {
-        band_bottom_m: band.bottom_m as f32,
-        band_top_m: band.top_m as f32,
-        coverage: r.coverage,
-        extinction_per_m: r.extinction_per_m,
-        map_extent_m: map_extent_m as f32,
-        detail_strength: r.detail_strength,
-        detail_scale_m: r.detail_scale_m,
-    }
+    r.density(band, map_extent_m)
 }
 
-/// The GPU renderer's settings for `[render]` settings `r` (see
-/// [`density_params`]) with `quality`.
+/// The GPU renderer's settings for `[render]` settings `r` with `quality`
+/// ([`RenderSettings::gpu_settings_at`]).
 pub fn gpu_settings(
     r: &RenderSettings,
     band: Band,
     map_extent_m: f64,
     quality: Quality,
 ) -> GpuSettings {
-    GpuSettings {
-        density: density_params(r, band, map_extent_m),
-        quality,
-        sun_elevation_deg: r.sun_elevation_deg,
-        sun_azimuth_deg: r.sun_azimuth_deg,
-        tsaa: r.tsaa.then_some(TsaaSettings {
-            blend: r.tsaa_blend,
-        }),
-        debug_sample_count: false,
-    }
+    r.gpu_settings_at(band, map_extent_m, quality)
 }
 
 /// The cloudy, released parcels as spheres in the world frame (the

@@ -6,9 +6,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::render::cloud_map::CloudMapConfig;
 use crate::render::cpu::camera::Camera;
+use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::Quality;
+use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::TerrainConfig;
-use crate::sim::Check;
+use crate::sim::{Band, Check};
 
 /// The `[render]` scene table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -280,6 +282,41 @@ impl RenderSettings {
             yaw_deg: self.camera_yaw_deg,
             pitch_deg: self.camera_pitch_deg,
             fov_deg: self.fov_deg,
+        }
+    }
+
+    /// The wgpu renderer's settings for this section over the cloud `band`
+    /// of a physics domain of side `map_extent_m` (the scene's
+    /// `physics.domain_size_m`), at this section's quality.
+    pub fn gpu_settings(&self, band: Band, map_extent_m: f64) -> GpuSettings {
+        self.gpu_settings_at(band, map_extent_m, self.quality())
+    }
+
+    /// [`Self::gpu_settings`] at another `quality`.
+    pub fn gpu_settings_at(&self, band: Band, map_extent_m: f64, quality: Quality) -> GpuSettings {
+        GpuSettings {
+            density: self.density(band, map_extent_m),
+            quality,
+            sun_elevation_deg: self.sun_elevation_deg,
+            sun_azimuth_deg: self.sun_azimuth_deg,
+            tsaa: self.tsaa.then_some(TsaaSettings {
+                blend: self.tsaa_blend,
+            }),
+            debug_sample_count: false,
+        }
+    }
+
+    /// The density's parameters for this section, a cloud band and the
+    /// map's extent (the physics domain).
+    pub fn density(&self, band: Band, map_extent_m: f64) -> DensityParams {
+        DensityParams {
+            band_bottom_m: band.bottom_m as f32,
+            band_top_m: band.top_m as f32,
+            coverage: self.coverage,
+            extinction_per_m: self.extinction_per_m,
+            map_extent_m: map_extent_m as f32,
+            detail_strength: self.detail_strength,
+            detail_scale_m: self.detail_scale_m,
         }
     }
 

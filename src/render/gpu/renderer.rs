@@ -62,6 +62,52 @@ pub enum RenderError {
 
 /// The wgpu cloud renderer. It sees the simulation only through the
 /// projected field P ([`CloudRenderer::update_field`]).
+///
+/// Clouds move only through P: the cloud map is fixed in the world (it
+/// tiles the physics domain), and the renderer has no wind or time input.
+/// The parcels drift with the wind and rise, fall and die; re-project them
+/// ([`crate::sim::Simulation::project_into`]) and call `update_field` each
+/// physics step, and the clouds move with them.
+///
+/// The settings come from a scene's `[render]` section with
+/// [`crate::scene::RenderSettings::gpu_settings`] (or
+/// [`crate::prepare::gpu_settings`]); nothing needs building by hand:
+///
+/// ```no_run
+/// # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, view: &wgpu::TextureView)
+/// #     -> Result<(), Box<dyn std::error::Error>> {
+/// use cumulus::render::cloud_map::CloudMap;
+/// use cumulus::render::gpu::CloudRenderer;
+/// use cumulus::scene::Scene;
+/// use cumulus::sim::{ProjectedField, Simulation};
+///
+/// let scene = Scene::builtin("fair_weather.toml").expect("shipped")?;
+/// let atm = scene.atmosphere(None)?;
+/// let band = scene.band(&atm);
+/// let r = &scene.render;
+/// let settings = r.gpu_settings(band, scene.physics.domain_size_m);
+/// let cloud_map = CloudMap::generate(&r.cloud_map);
+/// let mut clouds = CloudRenderer::new(
+///     device,
+///     queue,
+///     wgpu::TextureFormat::Rgba8UnormSrgb,
+///     &settings,
+///     &cloud_map,
+///     None,
+/// );
+/// clouds.resize(1280, 720);
+/// let mut sim = Simulation::new(scene.physics.clone(), atm);
+/// let mut p = ProjectedField::new(128, 128);
+/// // Each frame: step the physics, re-project P, upload it, record.
+/// sim.step();
+/// sim.project_into(&mut p, band);
+/// clouds.update_field(queue, &p);
+/// let mut encoder = device.create_command_encoder(&Default::default());
+/// clouds.render(&mut encoder, view, None, &r.camera())?;
+/// queue.submit([encoder.finish()]);
+/// # Ok(())
+/// # }
+/// ```
 pub struct CloudRenderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
