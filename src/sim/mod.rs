@@ -13,6 +13,7 @@ pub mod parcels;
 pub mod projection;
 pub mod solver;
 pub mod sounding;
+pub mod sounding_formats;
 mod spawn;
 pub mod sph;
 pub mod thermo;

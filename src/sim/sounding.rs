@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use super::constants::{G, R_D, ZERO_CELSIUS_K};
+use super::sounding_formats::{Format, detect, sharppy_to_csv, wyoming_to_csv};
 use super::thermo::{mixing_ratio_from_dewpoint, saturation_mixing_ratio};
 
 /// What went wrong reading a sounding; every message names the file and,
@@ -63,8 +64,28 @@ impl Sounding {
         Self::parse(&text, path, surface_pressure_pa)
     }
 
-    /// Parses sounding text; `path` is only used in messages.
+    /// Parses sounding text in any of the [`Format`]s (recognised by
+    /// content); `path` is only used in messages, whose line numbers are
+    /// those of `text`.
     pub fn parse(text: &str, path: &Path, surface_pressure_pa: f64) -> Result<Self, SoundingError> {
+        let converted = match detect(text) {
+            Format::Csv => None,
+            Format::Wyoming => Some(wyoming_to_csv(text)),
+            Format::Sharppy => Some(sharppy_to_csv(text)),
+        };
+        match converted {
+            None => Self::parse_csv(text, path, surface_pressure_pa),
+            Some(Ok(csv)) => Self::parse_csv(&csv, path, surface_pressure_pa),
+            Some(Err((line, message))) => Err(SoundingError::Invalid {
+                path: path.to_owned(),
+                line,
+                message,
+            }),
+        }
+    }
+
+    /// Parses our CSV.
+    fn parse_csv(text: &str, path: &Path, surface_pressure_pa: f64) -> Result<Self, SoundingError> {
         let err = |line: u64, message: String| SoundingError::Invalid {
             path: path.to_owned(),
             line,

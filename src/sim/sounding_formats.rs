@@ -1,0 +1,198 @@
+//! Soundings as meteorologists download them, read into the CSV that
+//! [`super::Sounding::parse`] reads: the University of Wyoming text listing
+//! (`TEXT:LIST`) and SHARPpy's `%RAW%` files. Each line of the original
+//! becomes one line of the CSV (a data row, or a `#` comment for headers,
+//! missing levels and trailers), so an error still names the line of the
+//! original file. Heights above sea level become heights above the lowest
+//! level.
+
+/// A format of sounding file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// `height_m,pressure_hPa,temperature_C,dewpoint_C` (ours).
+    Csv,
+    /// University of Wyoming `TEXT:LIST`: fixed columns of 7 characters,
+    /// `PRES HGHT TEMP DWPT ...` in hPa, m above sea level, °C, °C.
+    Wyoming,
+    /// SHARPpy: `%RAW%` ... `%END%`, comma-separated `LEVEL, HGHT, TEMP,
+    /// DWPT, WDIR, WSPD` in hPa, m above sea level, °C, °C; -9999 missing.
+    Sharppy,
+}
+
+/// The format of sounding text, from its content.
+pub fn detect(text: &str) -> Format {
+    if text.lines().any(|l| l.trim() == "%RAW%") {
+        Format::Sharppy
+    } else if text.lines().any(is_wyoming_header) {
+        Format::Wyoming
+    } else {
+        Format::Csv
+    }
+}
+
+fn is_wyoming_header(line: &str) -> bool {
+    let w: Vec<&str> = line.split_whitespace().collect();
+    w.len() >= 4 && w[..4] == ["PRES", "HGHT", "TEMP", "DWPT"]
+}
+
+const HEADER: &str = "height_m,pressure_hPa,temperature_C,dewpoint_C";
+
+/// A line that cannot be read, with its 1-based number and what is wrong.
+pub type LineError = (u64, String);
+
+/// The rows of `(pressure_hPa, height_m_asl, temperature_C, dewpoint_C)`
+/// per line of the original (`None`: not a level) as our CSV, heights above
+/// the lowest level.
+fn to_csv(lines: &[Option<[f64; 4]>]) -> Result<String, LineError> {
+    let ground = lines.iter().flatten().map(|r| r[1]).next();
+    let Some(ground) = ground else {
+        return Err((
+            1,
+            "no levels with pressure, height, temperature and dewpoint".into(),
+        ));
+    };
+    if lines.first().is_some_and(Option::is_some) {
+        return Err((
+            1,
+            "the first line is a level; expected a title or header".into(),
+        ));
+    }
+    let mut out = String::with_capacity(lines.len() * 40);
+    for (k, l) in lines.iter().enumerate() {
+        match (k, l) {
+            (0, _) => out.push_str(HEADER),
+            (_, Some([p, h, t, td])) => {
+                out.push_str(&format!("{},{p},{t},{td}", h - ground));
+            }
+            (_, None) => out.push('#'),
+        }
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+/// A number, or `None` for a blank field or a missing-value code.
+fn number(s: &str, line: u64, what: &str) -> Result<Option<f64>, LineError> {
+    let s = s.trim();
+    if s.is_empty() {
+        return Ok(None);
+    }
+    let v: f64 = s
+        .parse()
+        .map_err(|_| (line, format!("`{what}` is `{s}`, expected a number")))?;
+    Ok((v > -9998.0).then_some(v))
+}
+
+/// The University of Wyoming `TEXT:LIST` listing as our CSV. Levels with a
+/// blank temperature or dewpoint (the upper air often has none) are left
+/// out; the table ends at the first line that is not a level ("Station
+/// information and sounding indices").
+pub fn wyoming_to_csv(text: &str) -> Result<String, LineError> {
+    let all: Vec<&str> = text.lines().collect();
+    let Some(header) = all.iter().position(|l| is_wyoming_header(l)) else {
+        return Err((1, "no `PRES HGHT TEMP DWPT` header".into()));
+    };
+    let mut rows: Vec<Option<[f64; 4]>> = vec![None; all.len()];
+    let mut in_table = false;
+    for (k, l) in all.iter().enumerate().skip(header + 1) {
+        let line = k as u64 + 1;
+        if l.trim_start().starts_with('-') {
+            in_table = true;
+            continue;
+        }
+        if !in_table {
+            continue;
+        }
+        let field = |i: usize| l.get(7 * i..(7 * i + 7).min(l.len())).unwrap_or("");
+        // The table ends where the pressure column stops being a number.
+        if field(0).trim().parse::<f64>().is_err() {
+            break;
+        }
+        let [p, h, t, td] = [
+            number(field(0), line, "PRES")?,
+            number(field(1), line, "HGHT")?,
+            number(field(2), line, "TEMP")?,
+            number(field(3), line, "DWPT")?,
+        ];
+        if let (Some(p), Some(h), Some(t), Some(td)) = (p, h, t, td) {
+            rows[k] = Some([p, h, t, td]);
+        }
+    }
+    to_csv(&rows)
+}
+
+/// A SHARPpy `%RAW%` file as our CSV. Levels with a missing (-9999)
+/// pressure, height, temperature or dewpoint are left out.
+pub fn sharppy_to_csv(text: &str) -> Result<String, LineError> {
+    let all: Vec<&str> = text.lines().collect();
+    let mut rows: Vec<Option<[f64; 4]>> = vec![None; all.len()];
+    let mut in_raw = false;
+    for (k, l) in all.iter().enumerate() {
+        let line = k as u64 + 1;
+        match l.trim() {
+            "%RAW%" => in_raw = true,
+            "%END%" => in_raw = false,
+            "" => {}
+            t if in_raw => {
+                let f: Vec<&str> = t.split(',').collect();
+                if f.len() < 4 {
+                    return Err((
+                        line,
+                        format!(
+                            "{} fields, expected LEVEL, HGHT, TEMP, DWPT[, WDIR, WSPD]",
+                            f.len()
+                        ),
+                    ));
+                }
+                let [p, h, t, td] = [
+                    number(f[0], line, "LEVEL")?,
+                    number(f[1], line, "HGHT")?,
+                    number(f[2], line, "TEMP")?,
+                    number(f[3], line, "DWPT")?,
+                ];
+                if let (Some(p), Some(h), Some(t), Some(td)) = (p, h, t, td) {
+                    rows[k] = Some([p, h, t, td]);
+                }
+            }
+            _ => {}
+        }
+    }
+    to_csv(&rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wyoming_columns_and_blanks() {
+        let t = "Title line\n\
+-----------------------------------------------------------------------------\n\
+   PRES   HGHT   TEMP   DWPT   RELH   MIXR   DRCT   SKNT   THTA   THTE   THTV\n\
+    hPa     m      C      C      %    g/kg    deg   knot     K      K      K \n\
+-----------------------------------------------------------------------------\n\
+ 1012.0      2   27.2   23.2     79  18.07    110     10  299.3  351.7  302.6\n\
+ 1000.0    108   26.4   22.4     79  17.32    115     12  299.5  349.9  302.6\n\
+  100.0  16580  -75.1                                                        \n\
+Station information and sounding indices\n";
+        assert_eq!(detect(t), Format::Wyoming);
+        let csv = wyoming_to_csv(t).expect("reads");
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 9);
+        assert_eq!(lines[0], HEADER);
+        assert_eq!(lines[5], "0,1012,27.2,23.2");
+        assert_eq!(lines[6], "106,1000,26.4,22.4");
+        assert_eq!(lines[7], "#");
+    }
+
+    #[test]
+    fn sharppy_rows_and_a_bad_line() {
+        let t = "%TITLE%\n KEY 240601/1200\n\n   LEVEL       HGHT       TEMP       DWPT       WDIR       WSPD\n-------------------------------------------------------------------\n%RAW%\n1012.00, 2.00, 27.20, 23.20, 110.00, 10.00\n1000.00, 108.00, 26.40, -9999.00, 115.00, 12.00\n%END%\n";
+        assert_eq!(detect(t), Format::Sharppy);
+        let csv = sharppy_to_csv(t).expect("reads");
+        assert_eq!(csv.lines().nth(6), Some("0,1012,27.2,23.2"));
+        assert_eq!(csv.lines().nth(7), Some("#"));
+        let bad = t.replace("26.40", "warm");
+        assert_eq!(sharppy_to_csv(&bad).unwrap_err().0, 8);
+    }
+}
