@@ -1,6 +1,6 @@
 //! Soundings in the formats meteorologists download read to the same
 //! levels as our CSV: the University of Wyoming TEXT:LIST listing and a
-//! SHARPpy %RAW% file of the BOMEX sounding
+//! SHARPpy %RAW% file and IGRA2 sounding data of the BOMEX sounding
 //! (`tests/reference/make_format_examples.py`, heights above sea level, each
 //! format's own rounding), and bad lines named by file and line.
 
@@ -51,6 +51,14 @@ fn wyoming_text_list_reads_like_the_csv() {
 fn sharppy_raw_reads_like_the_csv() {
     let s = load(&root().join("tests/data/formats/bomex_sharppy.txt"));
     same_levels(&s, 0.005, 0.005, 0.005);
+}
+
+#[test]
+fn igra2_sounding_data_reads_like_the_csv() {
+    // The file holds two soundings; the first is read. The dewpoint comes
+    // from two rounded tenths (temperature and depression).
+    let s = load(&root().join("tests/data/formats/bomex_igra2.txt"));
+    same_levels(&s, 0.005, 0.5, 0.1);
 }
 
 #[test]

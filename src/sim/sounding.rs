@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use super::constants::{G, R_D, ZERO_CELSIUS_K};
-use super::sounding_formats::{Format, detect, sharppy_to_csv, wyoming_to_csv};
+use super::sounding_formats::{Format, detect, igra2_to_csv, sharppy_to_csv, wyoming_to_csv};
 use super::thermo::{mixing_ratio_from_dewpoint, saturation_mixing_ratio};
 
 /// What went wrong reading a sounding; every message names the file and,
@@ -72,6 +72,7 @@ impl Sounding {
             Format::Csv => None,
             Format::Wyoming => Some(wyoming_to_csv(text)),
             Format::Sharppy => Some(sharppy_to_csv(text)),
+            Format::Igra2 => Some(igra2_to_csv(text)),
         };
         match converted {
             None => Self::parse_csv(text, path, surface_pressure_pa),

@@ -17,6 +17,12 @@ pub enum Format {
     /// SHARPpy: `%RAW%` ... `%END%`, comma-separated `LEVEL, HGHT, TEMP,
     /// DWPT, WDIR, WSPD` in hPa, m above sea level, °C, °C; -9999 missing.
     Sharppy,
+    /// IGRA2 sounding data: a `#` header record (`#` and an 11-character
+    /// station id, then the year), then fixed-column levels: pressure (Pa,
+    /// columns 10-15), geopotential height (m, 17-21), temperature (0.1 °C,
+    /// 23-27), dewpoint depression (0.1 °C, 35-39); -9999 and -8888 missing.
+    /// The first sounding of a file is read.
+    Igra2,
 }
 
 /// The format of sounding text, from its content.
@@ -25,6 +31,8 @@ pub fn detect(text: &str) -> Format {
         Format::Sharppy
     } else if text.lines().any(is_wyoming_header) {
         Format::Wyoming
+    } else if text.lines().next().is_some_and(is_igra2_header) {
+        Format::Igra2
     } else {
         Format::Csv
     }
@@ -33,6 +41,15 @@ pub fn detect(text: &str) -> Format {
 fn is_wyoming_header(line: &str) -> bool {
     let w: Vec<&str> = line.split_whitespace().collect();
     w.len() >= 4 && w[..4] == ["PRES", "HGHT", "TEMP", "DWPT"]
+}
+
+fn is_igra2_header(line: &str) -> bool {
+    let b = line.as_bytes();
+    b.len() >= 17
+        && b[0] == b'#'
+        && b[1..12].iter().all(|c| c.is_ascii_alphanumeric())
+        && b[12] == b' '
+        && b[13..17].iter().all(u8::is_ascii_digit)
 }
 
 const HEADER: &str = "height_m,pressure_hPa,temperature_C,dewpoint_C";
@@ -155,6 +172,37 @@ pub fn sharppy_to_csv(text: &str) -> Result<String, LineError> {
                 }
             }
             _ => {}
+        }
+    }
+    to_csv(&rows)
+}
+
+/// The first sounding of an IGRA2 sounding-data file as our CSV. Levels
+/// without pressure, height, temperature or dewpoint depression are left
+/// out; the next `#` header record ends the sounding.
+pub fn igra2_to_csv(text: &str) -> Result<String, LineError> {
+    let all: Vec<&str> = text.lines().collect();
+    let mut rows: Vec<Option<[f64; 4]>> = vec![None; all.len()];
+    for (k, l) in all.iter().enumerate().skip(1) {
+        let line = k as u64 + 1;
+        if l.starts_with('#') {
+            break;
+        }
+        if l.trim().is_empty() {
+            continue;
+        }
+        // Columns are 1-based and inclusive in the format's description.
+        let col = |a: usize, b: usize| l.get(a - 1..b.min(l.len())).unwrap_or("");
+        let code = |s: &str, what: &str| -> Result<Option<f64>, LineError> {
+            let v = number(s, line, what)?;
+            Ok(v.filter(|&v| v > -8887.0))
+        };
+        let p = code(col(10, 15), "PRESS")?;
+        let z = code(col(17, 21), "GPH")?;
+        let t = code(col(23, 27), "TEMP")?;
+        let dpd = code(col(35, 39), "DPDP")?;
+        if let (Some(p), Some(z), Some(t), Some(dpd)) = (p, z, t, dpd) {
+            rows[k] = Some([p / 100.0, z, t / 10.0, (t - dpd) / 10.0]);
         }
     }
     to_csv(&rows)

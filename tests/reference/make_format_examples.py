@@ -47,4 +47,16 @@ with open(os.path.join(out, "bomex_sharppy.txt"), "w") as f:
     for p, h, t, td in rows:
         f.write(f"{p:8.2f}, {h:8.2f}, {t:8.2f}, {td:8.2f}, {90.0:8.2f}, {-9999.0:8.2f}\n")
     f.write("%END%\n")
-print("wrote tests/data/formats/bomex_wyoming.txt and bomex_sharppy.txt")
+with open(os.path.join(out, "bomex_igra2.txt"), "w") as f:
+    # Header record, then levels in IGRA2's fixed columns (1-based):
+    # LVLTYP1 1, LVLTYP2 2, ETIME 4-8, PRESS 10-15 (Pa), PFLAG 16,
+    # GPH 17-21 (m), ZFLAG 22, TEMP 23-27 (0.1 C), TFLAG 28, RH 29-33
+    # (0.1 %), DPDP 35-39 (0.1 C), WDIR 41-45, WSPD 47-51 (0.1 m/s).
+    f.write(f"#BMX00000001 1969 06 22 12 1200 {len(rows):4d} ncdc-gts ncdc-gts  131000  -590000\n")
+    for k, (p, h, t, td) in enumerate(rows):
+        lvl = "21" if k == 0 else "10"
+        f.write(f"{lvl} {-9999:5d} {round(p * 100):6d} {round(h):5d} {round(t * 10):5d} "
+                f"{round(rh(t, td) * 10):5d} {round((t - td) * 10):5d} {90:5d} {-9999:5d}\n")
+    f.write("#BMX00000001 1969 06 23 00 0000    1 ncdc-gts ncdc-gts  131000  -590000\n")
+    f.write("21 -9999 101500     5   250 -9999    40    90 -9999\n")
+print("wrote tests/data/formats/bomex_wyoming.txt, bomex_sharppy.txt and bomex_igra2.txt")
