@@ -102,31 +102,10 @@ fn sph_crossover(c: &mut Criterion) {
     g.finish();
 }
 
-/// The analytic tropical sounding of `n` levels, 0-16 km, that
-/// `benches/metpy_profile_timing.py` builds too: T = 27 °C - 6.5 K/km up to
-/// 11 km, then isothermal; dewpoint depression 2 K + 1.5 K/km; 1010 hPa at
-/// the ground, pressures filled hydrostatically.
-fn analytic_sounding(n: usize) -> Sounding {
-    let mut text = String::from("height_m,pressure_hPa,temperature_C,dewpoint_C\n");
-    for i in 0..n {
-        let z = 16_000.0 * i as f64 / (n - 1) as f64;
-        let t = 27.0 - 6.5e-3 * z.min(11_000.0);
-        let td = t - 2.0 - 1.5e-3 * z;
-        let p = if i == 0 {
-            "1010".to_owned()
-        } else {
-            String::new()
-        };
-        text.push_str(&format!("{z:.3},{p},{t:.4},{td:.4}\n"));
-    }
-    Sounding::parse(&text, std::path::Path::new("analytic.csv"), 101_000.0)
-        .expect("the analytic sounding is valid")
-}
-
 fn profile(c: &mut Criterion) {
     let mut g = c.benchmark_group("lcl_and_pseudo_profile");
     for n in [17, 401, 4001] {
-        let s = analytic_sounding(n);
+        let s = Sounding::analytic_tropical(n);
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| lift_sounding(&s, Adiabat::Pseudo))
         });

@@ -124,24 +124,6 @@ fn hydrostatic_fill_matches_metpy_hypsometric_pressures() {
     }
 }
 
-/// An analytic tropical sounding of `n` levels from 0 to 16 km (the one
-/// `benches/physics.rs` and `benches/metpy_profile_timing.py` use).
-fn analytic_sounding(n: usize) -> Sounding {
-    let mut text = String::from("height_m,pressure_hPa,temperature_C,dewpoint_C\n");
-    for i in 0..n {
-        let z = 16_000.0 * i as f64 / (n - 1) as f64;
-        let t = 27.0 - 6.5e-3 * z.min(11_000.0);
-        let td = t - 2.0 - 1.5e-3 * z;
-        let p = if i == 0 {
-            "1010".to_owned()
-        } else {
-            String::new()
-        };
-        text.push_str(&format!("{z:.3},{p},{t:.4},{td:.4}\n"));
-    }
-    Sounding::parse(&text, std::path::Path::new("analytic.csv"), 101_000.0).expect("valid")
-}
-
 /// The pseudo-adiabat is integrated level to level: its work grows with the
 /// pressure span (one RK4 step per `PSEUDO_STEP_PA` plus one per level),
 /// not with levels times span (it was re-integrated from the LCL for every
@@ -149,7 +131,7 @@ fn analytic_sounding(n: usize) -> Sounding {
 #[test]
 fn pseudo_profile_work_is_linear_in_levels() {
     use cumulus::sim::lift::PSEUDO_STEP_PA;
-    let s = analytic_sounding(2501);
+    let s = Sounding::analytic_tropical(2501);
     let prof = lift_sounding(&s, Adiabat::Pseudo);
     let span = prof.lcl.pressure_pa - prof.rows.last().expect("rows").pressure_pa;
     let bound = (span / PSEUDO_STEP_PA).ceil() as usize + s.levels().len();

@@ -297,6 +297,25 @@ impl Sounding {
         })
     }
 
+    /// An analytic deep tropical column of `n` levels (>= 2) from 0 to
+    /// 16 km, for benchmarks and tests: T = 27 °C - 6.5 K/km up to 11 km,
+    /// then isothermal; dewpoint depression 2 K + 1.5 K/km; 1010 hPa at the
+    /// ground, pressures filled hydrostatically
+    /// (`benches/metpy_profile_timing.py` builds the same one).
+    pub fn analytic_tropical(n: usize) -> Self {
+        let n = n.max(2);
+        let mut text = String::from("height_m,pressure_hPa,temperature_C,dewpoint_C\n");
+        for i in 0..n {
+            let z = 16_000.0 * i as f64 / (n - 1) as f64;
+            let t = 27.0 - 6.5e-3 * z.min(11_000.0);
+            let td = t - 2.0 - 1.5e-3 * z;
+            let p = if i == 0 { "1010" } else { "" };
+            text.push_str(&format!("{z:.3},{p},{t:.4},{td:.4}\n"));
+        }
+        Self::parse(&text, Path::new("analytic_tropical.csv"), 101_000.0)
+            .expect("the analytic column is a valid sounding")
+    }
+
     /// The levels, lowest first.
     pub fn levels(&self) -> &[Level] {
         &self.levels

@@ -216,9 +216,6 @@ pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityP
 /// per-frame offsets. `offsets = 1` is [`render_linear`].
 pub fn render_linear_offsets(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec3> {
     let n = offsets.max(1);
-    if n == 1 {
-        return render_linear(width, height, fr);
-    }
     let w = width as usize;
     let mut out = vec![Vec3::ZERO; w * height as usize];
     out.par_chunks_mut(w.max(1))
@@ -238,25 +235,12 @@ pub fn render_linear_offsets(width: u32, height: u32, fr: &Frame, offsets: u32) 
     out
 }
 
-/// Renders a `width x height` image of linear radiance, row-major.
+/// Renders a `width x height` image of linear radiance, row-major, each
+/// pixel one march with its fixed dither (the GPU's twin without TSAA).
 pub fn render_linear(width: u32, height: u32, fr: &Frame) -> Vec<Vec3> {
-    let w = width as usize;
-    let mut out = vec![Vec3::ZERO; w * height as usize];
-    out.par_chunks_mut(w.max(1))
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, px) in row.iter_mut().enumerate() {
-                let dir = fr.camera.ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
-                *px = march_ray(
-                    fr.camera.position_m,
-                    dir,
-                    pixel_dither(x as u32, y as u32),
-                    fr,
-                )
-                .radiance;
-            }
-        });
-    out
+    // One offset: the dither itself (fract of a value in [0, 1) is itself,
+    // and a sum of one divided by one is exact).
+    render_linear_offsets(width, height, fr, 1)
 }
 
 /// A `width x height` image of `samples x samples` rays per pixel
