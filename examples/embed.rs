@@ -8,7 +8,7 @@
 //! `cargo run --release --example embed -- [OUT.png]`
 
 use anyhow::{Context, Result};
-use cumulus::prepare::{gpu_settings, spawn_sites};
+use cumulus::prepare::spawn_sites;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::camera::Camera;
 use cumulus::render::gpu::{CloudRenderer, GpuContext};
@@ -68,7 +68,7 @@ fn main() -> Result<()> {
         sun_azimuth_deg: 140.0,
         ..RenderSettings::default()
     };
-    let settings = gpu_settings(&look, band, extent, look.quality());
+    let settings = look.gpu_settings(band, extent);
     let mut clouds = CloudRenderer::new(device, queue, format, &settings, &cloud_map, None);
     clouds.resize(width, height);
 

@@ -7,7 +7,7 @@
 use glam::DVec2;
 
 use crate::render::cloud_map::CloudMap;
-use crate::render::cpu::density::{DensityParams, Fields};
+use crate::render::cpu::density::Fields;
 use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::gpu::baseline::Sphere;
 use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless};
@@ -67,7 +67,7 @@ impl Prepared {
 
     /// The GPU renderer's settings for `r` with `quality`.
     pub fn gpu_settings(&self, r: &RenderSettings, quality: Quality) -> GpuSettings {
-        gpu_settings(r, self.band, self.map_extent_m, quality)
+        r.gpu_settings_at(self.band, self.map_extent_m, quality)
     }
 
     /// A `width x height` offscreen GPU renderer of these fields.
@@ -98,7 +98,7 @@ impl Prepared {
                 p: &self.field,
                 cloud_map: &self.cloud_map,
             },
-            density: density_params(r, self.band, self.map_extent_m),
+            density: r.density(self.band, self.map_extent_m),
             quality,
             terrain: self.terrain.as_ref(),
         }
@@ -118,23 +118,6 @@ pub fn spawn_sites(cloud_map: &CloudMap, extent_m: f64) -> Vec<DVec2> {
         .into_iter()
         .map(|(u, v)| DVec2::new(u as f64 * extent_m, v as f64 * extent_m))
         .collect()
-}
-
-/// The density's parameters for `[render]` settings `r`, a cloud band and
-/// the map's extent ([`RenderSettings::density`]).
-pub fn density_params(r: &RenderSettings, band: Band, map_extent_m: f64) -> DensityParams {
-    r.density(band, map_extent_m)
-}
-
-/// The GPU renderer's settings for `[render]` settings `r` with `quality`
-/// ([`RenderSettings::gpu_settings_at`]).
-pub fn gpu_settings(
-    r: &RenderSettings,
-    band: Band,
-    map_extent_m: f64,
-    quality: Quality,
-) -> GpuSettings {
-    r.gpu_settings_at(band, map_extent_m, quality)
 }
 
 /// The cloudy, released parcels as spheres in the world frame (the

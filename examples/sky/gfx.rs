@@ -5,7 +5,6 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result, anyhow};
-use cumulus::prepare::gpu_settings;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings};
 use winit::window::Window;
 
@@ -31,12 +30,7 @@ pub struct Gfx {
 /// The cloud renderer's settings for the world's scene.
 pub fn settings_of(world: &World) -> GpuSettings {
     let r = &world.scene.render;
-    gpu_settings(
-        r,
-        world.band,
-        world.scene.physics.domain_size_m,
-        r.quality(),
-    )
+    r.gpu_settings(world.band, world.scene.physics.domain_size_m)
 }
 
 impl Gfx {

@@ -70,8 +70,8 @@ pub enum RenderError {
 /// physics step, and the clouds move with them.
 ///
 /// The settings come from a scene's `[render]` section with
-/// [`crate::scene::RenderSettings::gpu_settings`] (or
-/// [`crate::prepare::gpu_settings`]); nothing needs building by hand:
+/// [`crate::scene::RenderSettings::gpu_settings`]; nothing needs building
+/// by hand:
 ///
 /// ```no_run
 /// # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, view: &wgpu::TextureView)
