@@ -22,3 +22,11 @@ pub enum ReportError {
         message: String,
     },
 }
+
+impl ReportError {
+    /// The error constructor for a failed write of `path` (for `map_err`).
+    pub fn writing(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> Self + use<> {
+        let path = path.to_owned();
+        move |source| Self::Write { path, source }
+    }
+}

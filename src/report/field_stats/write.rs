@@ -14,10 +14,6 @@ const PER_KM_PER_KM2: f64 = 1e9;
 /// `cloud_fraction_profile.csv`, `stats.json` and the two log-log plots
 /// (`area_perimeter.png`, `size_density.png`) into `dir`.
 pub fn write(s: &FieldStats, title: &str, dir: &Path) -> Result<(), ReportError> {
-    let werr = |path: &Path| {
-        let path = path.to_owned();
-        move |source| ReportError::Write { path, source }
-    };
     let path = dir.join("clouds.csv");
     write_atomically(&path, |out| {
         writeln!(out, "cells,area_m2,perimeter_m,diameter_m")?;
@@ -30,7 +26,7 @@ pub fn write(s: &FieldStats, title: &str, dir: &Path) -> Result<(), ReportError>
         }
         Ok(())
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("size_density.csv");
     write_atomically(&path, |out| {
         writeln!(out, "diameter_m,lo_m,hi_m,count,density_per_m3")?;
@@ -43,7 +39,7 @@ pub fn write(s: &FieldStats, title: &str, dir: &Path) -> Result<(), ReportError>
         }
         Ok(())
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("cloud_fraction_profile.csv");
     write_atomically(&path, |out| {
         writeln!(out, "height_m,cloud_fraction")?;
@@ -52,13 +48,13 @@ pub fn write(s: &FieldStats, title: &str, dir: &Path) -> Result<(), ReportError>
         }
         Ok(())
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("stats.json");
     write_atomically(&path, |out| {
         serde_json::to_writer_pretty(&mut *out, s).map_err(std::io::Error::other)?;
         writeln!(out)
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let fitted = |f: Option<Fit>, xs: Vec<f64>| -> Vec<(f64, f64)> {
         f.map(|f| {
             xs.iter()

@@ -10,10 +10,6 @@ use crate::report::plot::{Series, bars_png, loglog_png};
 /// Writes `bench.csv`, `physics_in_frame.csv`, `render_error.csv`,
 /// `bench.json` and the plots into `dir`.
 pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
-    let werr = |path: &Path| {
-        let path = path.to_owned();
-        move |source| ReportError::Write { path, source }
-    };
     let path = dir.join("bench.csv");
     write_atomically(&path, |out| {
         writeln!(out, "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,frames,p_covered,median_ms,p95_ms,timing")?;
@@ -26,7 +22,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         }
         Ok(())
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("physics_in_frame.csv");
     write_atomically(&path, |out| {
         writeln!(
@@ -42,7 +38,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         }
         Ok(())
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("render_error.csv");
     write_atomically(&path, |out| {
         writeln!(out, "knob,value,ms,mean_abs_error,is_default")?;
@@ -55,13 +51,13 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         }
         Ok(())
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("bench.json");
     write_atomically(&path, |out| {
         serde_json::to_writer_pretty(&mut *out, report).map_err(std::io::Error::other)?;
         writeln!(out)
     })
-    .map_err(werr(&path))?;
+    .map_err(ReportError::writing(&path))?;
 
     let device = format!("{} ({} timing)", report.adapter, report.timing);
     let series_of = |group: &str, renderer: &str, x: fn(&Row) -> f64| Series {
