@@ -318,7 +318,6 @@ impl App {
             g.egui.free_texture(id);
         }
         let last = screenshot && self.frames_done + 1 >= self.args.frames;
-        let readback = last.then(|| screenshot::copy(&g.ctx.device, &mut encoder, &frame.texture));
         g.ctx
             .queue
             .submit(extra.into_iter().chain([encoder.finish()]));
@@ -335,9 +334,10 @@ impl App {
             self.timings.cloud_pass_ms =
                 Some(t[2 * k + 1].saturating_sub(t[2 * k]) as f64 * g.period_ns * 1e-6);
         }
-        if let Some(r) = readback {
+        if last {
+            // The frame is submitted and not yet presented: read it back.
             let path = self.args.screenshot.clone().unwrap_or_default();
-            let (w, h) = screenshot::save(&g.ctx, r, g.config.format, &path)?;
+            let (w, h) = screenshot::save(&g.ctx, &frame.texture, &path)?;
             println!(
                 "wrote {} ({w}x{h}, {} frames, {})",
                 path.display(),
