@@ -23,13 +23,15 @@ const MIN_TRANSMITTANCE: f32 = 0.01;
 const SUN_DISK_COS: f32 = 0.999989;
 // The longest shadow ray toward the sun, m.
 const SHADOW_RAY_M: f32 = 2000.0;
+// The clip depth at which rays are unprojected.
+const RAY_DEPTH: f32 = 0.5;
 
-// Mirrors `FrameUniforms` in src/render/gpu/uniforms.rs (352 bytes).
+// Mirrors `FrameUniforms` in src/render/gpu/uniforms.rs (448 bytes). The
+// camera is `View`'s (src/render/camera.rs): any perspective projection,
+// standard or reversed depth.
 struct Frame {
-    cam_pos: vec4f,      // xyz, tan(fov / 2)
-    cam_forward: vec4f,  // xyz, aspect
-    cam_right: vec4f,    // xyz, width in pixels
-    cam_up: vec4f,       // xyz, height in pixels
+    cam_pos: vec4f,      // eye xyz (m), unused
+    screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
     ambient_top: vec4f,  // sky_radiance(up) / 4, exposure
@@ -37,11 +39,13 @@ struct Frame {
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), unused
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
-    depth: vec4f,        // near, far (m), terrain extent (m), terrain max (m)
+    terrain: vec4f,      // extent (m), highest point (m), unused, unused
     counts: vec4u,       // steps, P width, P height, frame index
     mask: vec4u,         // mask width, height, P texels per mask cell, unused
     view_proj: mat4x4f,
     prev_view_proj: mat4x4f,
+    inverse_projection: mat4x4f,
+    view_to_world: mat4x4f,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -285,12 +289,16 @@ fn tone_map(c: f32, exposure: f32) -> f32 {
 }
 
 // The ray through pixel coordinate `px` (0.5 = a pixel's centre).
+// Normalised device coordinates of a pixel position (y up).
+fn pixel_ndc(px: vec2f) -> vec2f {
+    return vec2f(2.0 * px.x / frame.screen.x - 1.0, 1.0 - 2.0 * px.y / frame.screen.y);
+}
+
+// The unit world ray through pixel position `px` (unprojected at depth
+// RAY_DEPTH, finite for every perspective projection).
 fn camera_ray(px: vec2f) -> vec3f {
-    let tan_half = frame.cam_pos.w;
-    let aspect = frame.cam_forward.w;
-    let sx = (2.0 * px.x / frame.cam_right.w - 1.0) * tan_half * aspect;
-    let sy = (1.0 - 2.0 * px.y / frame.cam_up.w) * tan_half;
-    return normalize(frame.cam_forward.xyz + frame.cam_right.xyz * sx + frame.cam_up.xyz * sy);
+    let q = frame.inverse_projection * vec4f(pixel_ndc(px), RAY_DEPTH, 1.0);
+    return normalize((frame.view_to_world * vec4f(q.xyz / q.w, 0.0)).xyz);
 }
 
 // The result of one ray: premultiplied cloud radiance (the light of the
@@ -377,14 +385,27 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     return out;
 }
 
-// Distance along `dir` to the surface at depth-buffer value `d` (the
-// projection of `Camera::view_projection`: left-handed, depth 0 at `near`,
-// 1 at `far`).
-fn depth_to_distance(d: f32, dir: vec3f) -> f32 {
-    let near = frame.depth.x;
-    let far = frame.depth.y;
-    let z = near * far / (far - d * (far - near));
-    return z / max(dot(dir, frame.cam_forward.xyz), 1e-6);
+// The view's depth of a depth-buffer value: the terrain's buffer under a
+// reversed-depth view stores it flipped (1 - d).
+fn view_depth(d: f32) -> f32 {
+    return mix(d, 1.0 - d, frame.screen.w);
+}
+
+// Distance from the eye to the surface at the view's depth `z` at pixel
+// position `px` (any perspective projection; infinite at an infinite far
+// plane).
+fn depth_to_distance(z: f32, px: vec2f) -> f32 {
+    let q = frame.inverse_projection * vec4f(pixel_ndc(px), z, 1.0);
+    if abs(q.w) <= 1e-30 * length(q.xyz) || q.w == 0.0 {
+        return 3.0e38;
+    }
+    return length(q.xyz / q.w);
+}
+
+// Whether the view's depth `z` is geometry (not the far value a depth
+// buffer is cleared to).
+fn is_geometry(z: f32) -> bool {
+    return z != frame.screen.z;
 }
 
 // The march of one pixel at fragment position `pos` up to `max_t`.

@@ -10,7 +10,7 @@
 // Bilinear, periodic height at world (x, z), m (`Heightfield::height_at`).
 fn height_at(x: f32, z: f32) -> f32 {
     let n = i32(textureDimensions(height_tex).x);
-    let extent = frame.depth.z;
+    let extent = frame.terrain.x;
     let fx = x / extent * f32(n);
     let fz = z / extent * f32(n);
     let x0 = floor(fx);
@@ -31,7 +31,7 @@ fn height_at(x: f32, z: f32) -> f32 {
 }
 
 fn normal_at(x: f32, z: f32) -> vec3f {
-    let e = frame.depth.z / f32(textureDimensions(height_tex).x);
+    let e = frame.terrain.x / f32(textureDimensions(height_tex).x);
     let dx = height_at(x + e, z) - height_at(x - e, z);
     let dz = height_at(x, z + e) - height_at(x, z - e);
     return normalize(vec3f(-dx, 2.0 * e, -dz));
@@ -75,7 +75,7 @@ struct TerrainVertex {
 @vertex
 fn vs_terrain(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> TerrainVertex {
     let n = textureDimensions(height_tex).x;
-    let extent = frame.depth.z;
+    let extent = frame.terrain.x;
     let quad = vi / 6u;
     let corner = vi % 6u;
     var d = vec2u(0u, 0u);
@@ -97,6 +97,11 @@ fn vs_terrain(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
     var out: TerrainVertex;
     out.world = vec3f(xz.x, y, xz.y);
     out.clip = frame.view_proj * vec4f(out.world, 1.0);
+    // A reversed-depth view's depth is stored flipped (1 - d), so this
+    // buffer is always cleared to 1 and compared with `Less`; the cloud
+    // pass flips it back (`frame.screen.w`). `screen.z` is the view's far
+    // depth: 1 standard (no flip), 0 reversed.
+    out.clip.z = mix(out.clip.w - out.clip.z, out.clip.z, frame.screen.z);
     return out;
 }
 

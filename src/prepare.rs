@@ -91,7 +91,10 @@ impl Prepared {
     /// The CPU frame for `settings` with `quality`.
     pub fn frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
         Frame {
-            camera: r.camera(),
+            view: r.camera().view(
+                r.width as f32 / r.height.max(1) as f32,
+                quality.max_distance_m,
+            ),
             sun_elevation_deg: r.sun_elevation_deg,
             sun_azimuth_deg: r.sun_azimuth_deg,
             fields: Fields {

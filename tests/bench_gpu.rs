@@ -9,7 +9,7 @@ mod common;
 use common::gpu;
 
 use cumulus::prepare::Prepared;
-use cumulus::render::cpu::camera::Camera;
+use cumulus::render::camera::Camera;
 use cumulus::render::gpu::baseline::BaselineRenderer;
 use cumulus::render::gpu::headless::TARGET_FORMAT;
 use cumulus::render::gpu::{Headless, textures};

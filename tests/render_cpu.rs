@@ -1,7 +1,7 @@
 //! The CPU reference renderer: density, lighting and image properties.
 
+use cumulus::render::camera::Camera;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
-use cumulus::render::cpu::camera::Camera;
 use cumulus::render::cpu::density::{
     BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
 };
@@ -195,12 +195,13 @@ fn constant_slab_transmittance_matches_beer_lambert() {
         .sum();
     assert!(tau > 0.1, "a real slab: τ = {tau}");
     let frame = Frame {
-        camera: Camera {
+        view: Camera {
             position_m: origin,
             yaw_deg: 0.0,
             pitch_deg: 89.9,
             fov_deg: 1.0,
-        },
+        }
+        .view(1.0, 1e5),
         sun_elevation_deg: 60.0,
         sun_azimuth_deg: 0.0,
         fields,
@@ -226,12 +227,13 @@ fn constant_slab_transmittance_matches_beer_lambert() {
 
 fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
     Frame {
-        camera: Camera {
+        view: Camera {
             position_m: Vec3::new(0.0, 100.0, 0.0),
             yaw_deg: 30.0,
             pitch_deg: 15.0,
             fov_deg: 60.0,
-        },
+        }
+        .view(96.0 / 64.0, 40_000.0),
         sun_elevation_deg: 40.0,
         sun_azimuth_deg: 135.0,
         fields: Fields { p, cloud_map: cm },
@@ -260,8 +262,8 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
         .iter()
         .enumerate()
         .filter(|(k, _)| {
-            fr.camera
-                .ray((k % 96) as f32 + 0.5, (k / 96) as f32 + 0.5, 96, 64)
+            fr.view
+                .camera_ray((k % 96) as f32 + 0.5, (k / 96) as f32 + 0.5, 96, 64)
                 .y
                 > 0.02
         })
@@ -284,8 +286,8 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
         .iter()
         .enumerate()
         .filter(|(k, c)| {
-            fr.camera
-                .ray((k % 96) as f32 + 0.5, (k / 96) as f32 + 0.5, 96, 64)
+            fr.view
+                .camera_ray((k % 96) as f32 + 0.5, (k / 96) as f32 + 0.5, 96, 64)
                 .y
                 > 0.02
                 && c.z < 1.15 * c.x

@@ -297,7 +297,7 @@ fn tsaa_reprojects_a_rotation_without_ghosting() {
     let (w, h) = (80, 60);
     let r = &sc.render;
     let a = r.camera();
-    let b = cumulus::render::cpu::camera::Camera {
+    let b = cumulus::render::camera::Camera {
         yaw_deg: a.yaw_deg + 4.0,
         ..a
     };

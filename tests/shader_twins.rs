@@ -16,15 +16,14 @@ use cumulus::render::gpu::uniforms::FrameUniforms;
 
 /// WGSL functions with no Rust function of the same name, and why.
 const GPU_ONLY: &[(&str, &str)] = &[
-    // The CPU renderer calls `Camera::ray` (a method).
-    ("camera_ray", "the CPU's Camera::ray"),
     // The fragment body of the cloud pass; the CPU loop is render_linear.
     ("cloud_pixel", "per-pixel glue around march_ray"),
     // The GPU's early exit over empty sky; the CPU has CoverageMask::build
     // and tests the mask conservative against density_at.
     ("coarse_empty", "reads CoverageMask's cells"),
-    // Reads the depth buffer; the CPU intersects the heightfield instead.
-    ("depth_to_distance", "no depth buffer on the CPU"),
+    // The terrain pass's depth buffer stores a reversed view's depth
+    // flipped; the CPU intersects the heightfield and has no depth buffer.
+    ("view_depth", "no depth buffer on the CPU"),
     // Tone map plus sRGB encode of the composite; the CPU's to_srgb8.
     ("display", "the CPU's to_srgb8"),
     ("srgb_encode", "inside the CPU's to_srgb8"),
@@ -52,6 +51,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE as f64),
         ("SUN_DISK_COS", sky::SUN_DISK_COS as f64),
         ("SHADOW_RAY_M", lighting::SHADOW_RAY_M as f64),
+        ("RAY_DEPTH", cumulus::render::camera::RAY_DEPTH as f64),
     ]
 }
 
@@ -175,9 +175,9 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
     macro_rules! offsets {
         ($t:ty: $($f:ident),*) => { [$((stringify!($f), offset_of!($t, $f))),*] };
     }
-    let rust = offsets!(FrameUniforms: cam_pos, cam_forward, cam_right, cam_up, sun_dir,
-        sun_light, ambient_top, sky_up, band, map, jitter, depth, counts, mask, view_proj,
-        prev_view_proj);
+    let rust = offsets!(FrameUniforms: cam_pos, screen, sun_dir, sun_light, ambient_top,
+        sky_up, band, map, jitter, terrain, counts, mask, view_proj, prev_view_proj,
+        inverse_projection, view_to_world);
     same_layout("Frame", &rust, size_of::<FrameUniforms>());
     let rust = offsets!(Sphere: centre_radius, fill);
     same_layout("Sphere", &rust, size_of::<Sphere>());

@@ -1,7 +1,7 @@
 //! The demo's camera: orbit around a point or fly (mouse + WASD), reset,
 //! and bookmarked views.
 
-use cumulus::render::cpu::camera::Camera;
+use cumulus::render::camera::Camera;
 use glam::Vec3;
 
 /// How the mouse and keys move the camera.

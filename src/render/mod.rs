@@ -3,6 +3,7 @@
 //! the fallback without a GPU). Sees the simulation only through P
 //! (`sim::ProjectedField`, `sim::Band`).
 
+pub mod camera;
 pub mod cloud_map;
 pub mod coverage_mask;
 pub mod cpu;

@@ -4,8 +4,8 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::render::camera::Camera;
 use crate::render::cloud_map::CloudMapConfig;
-use crate::render::cpu::camera::Camera;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::Quality;
 use crate::render::gpu::{GpuSettings, TsaaSettings};

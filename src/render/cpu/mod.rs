@@ -6,7 +6,6 @@
 //! `(x, y)` maps to the world's `(x, z)`; P and the cloud map both span
 //! `map_extent_m` and repeat to the horizon.
 
-pub mod camera;
 pub mod density;
 pub mod lighting;
 pub mod renderer;

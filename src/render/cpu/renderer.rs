@@ -1,13 +1,13 @@
 //! The CPU reference renderer: per pixel (rayon over rows), deterministic
 //! (ray starts at pixel centres, no jitter), any step count.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::camera::Camera;
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
 use super::sky::{sky_radiance, sun_color, sun_direction, sun_disk};
+use crate::render::camera::View;
 use crate::render::terrain::Heightfield;
 
 /// Quality and look (scene table `[render]` keys that are not camera,
@@ -36,7 +36,9 @@ pub const MIN_TRANSMITTANCE: f32 = 0.01;
 /// Everything a frame needs.
 #[derive(Clone, Copy)]
 pub struct Frame<'a> {
-    pub camera: Camera,
+    /// The camera (a scene's [`crate::render::camera::Camera`] made a view
+    /// with the image's aspect, or an application's matrices).
+    pub view: View,
     pub sun_elevation_deg: f32,
     pub sun_azimuth_deg: f32,
     pub fields: Fields<'a>,
@@ -50,7 +52,11 @@ pub struct Frame<'a> {
 /// of the clouds along it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RaySample {
+    /// Everything the ray sees: the clouds over the sky or terrain.
     pub radiance: Vec3,
+    /// The clouds' own light (with the haze in front of them),
+    /// premultiplied: `radiance = clouds + transmittance · background`.
+    pub clouds: Vec3,
     pub transmittance: f32,
 }
 
@@ -92,6 +98,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
     let Some((t0, t1)) = band_segment(origin, dir, d.band_bottom_m, d.band_top_m, max_t) else {
         return RaySample {
             radiance: background,
+            clouds: Vec3::ZERO,
             transmittance: 1.0,
         };
     };
@@ -153,9 +160,10 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
         Vec3::new(dir.x, dir.y.max(0.0), dir.z).normalize_or(Vec3::Y),
         sun_dir,
     );
-    let radiance = light * haze + horizon * (opacity * (1.0 - haze)) + background * transmittance;
+    let clouds = light * haze + horizon * (opacity * (1.0 - haze));
     RaySample {
-        radiance,
+        radiance: clouds + background * transmittance,
+        clouds,
         transmittance,
     }
 }
@@ -222,14 +230,59 @@ pub fn render_linear_offsets(width: u32, height: u32, fr: &Frame, offsets: u32) 
         .enumerate()
         .for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
-                let dir = fr.camera.ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
-                let d0 = pixel_dither(x as u32, y as u32);
-                let mut sum = Vec3::ZERO;
-                for k in 0..n {
-                    let d = (d0 + k as f32 / n as f32).fract();
-                    sum += march_ray(fr.camera.position_m, dir, d, fr).radiance;
-                }
-                *px = sum / n as f32;
+                *px = mean_march(x as u32, y as u32, width, height, fr, n, |s| {
+                    s.radiance.extend(0.0)
+                })
+                .truncate();
+            }
+        });
+    out
+}
+
+/// The mean of `pick` over `n` shifted marches of pixel `(x, y)`.
+fn mean_march(
+    x: u32,
+    y: u32,
+    width: u32,
+    height: u32,
+    fr: &Frame,
+    n: u32,
+    pick: impl Fn(RaySample) -> Vec4,
+) -> Vec4 {
+    let dir = fr
+        .view
+        .camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
+    let d0 = pixel_dither(x, y);
+    let mut sum = Vec4::ZERO;
+    for k in 0..n {
+        let d = (d0 + k as f32 / n as f32).fract();
+        sum += pick(march_ray(fr.view.eye(), dir, d, fr));
+    }
+    sum / n as f32
+}
+
+/// The clouds alone, without the sky or terrain behind them: per pixel
+/// the premultiplied cloud radiance (`xyz`, linear, the haze in front of
+/// the clouds included) and opacity (`w`, one minus the transmittance),
+/// the mean of `offsets` shifted marches; an application composites it as
+/// `clouds.xyz + (1 - clouds.w) · background`. The terrain is not marched
+/// to (the twin of the GPU's clouds-only output, which marches only to
+/// the application's depth buffer).
+pub fn render_clouds_linear(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec4> {
+    let fr = &Frame {
+        terrain: None,
+        ..*fr
+    };
+    let n = offsets.max(1);
+    let w = width as usize;
+    let mut out = vec![Vec4::ZERO; w * height as usize];
+    out.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, px) in row.iter_mut().enumerate() {
+                *px = mean_march(x as u32, y as u32, width, height, fr, n, |s| {
+                    s.clouds.extend(1.0 - s.transmittance)
+                });
             }
         });
     out

@@ -9,7 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use super::bind::{self, Recorder};
 use super::settings::GpuSettings;
 use super::uniforms::{FrameInputs, FrameUniforms};
-use crate::render::cpu::camera::Camera;
+use crate::render::camera::Camera;
 
 /// The baseline's WGSL.
 pub const BASELINE: &str = include_str!("../../../shaders/baseline.wgsl");
@@ -148,8 +148,10 @@ impl BaselineRenderer {
         if self.width == 0 || self.height == 0 {
             return;
         }
+        let aspect = self.width as f32 / self.height as f32;
         let u = FrameUniforms::new(&FrameInputs {
-            camera: *camera,
+            view: camera.view(aspect, self.settings.quality.max_distance_m),
+            depth_flipped: false,
             prev_view_proj: glam::Mat4::IDENTITY,
             width: self.width,
             height: self.height,

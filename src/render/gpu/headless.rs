@@ -6,8 +6,8 @@ use super::renderer::CloudRenderer;
 use super::settings::GpuSettings;
 use super::textures;
 use super::timer::{FrameTimes, time_frames};
+use crate::render::camera::ToView;
 use crate::render::cloud_map::CloudMap;
-use crate::render::cpu::camera::Camera;
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
 
@@ -70,7 +70,7 @@ impl Headless {
     pub fn render(
         &mut self,
         ctx: &GpuContext,
-        camera: &Camera,
+        camera: &impl ToView,
         frames: u32,
     ) -> Result<(), GpuError> {
         for _ in 0..frames {
@@ -79,7 +79,7 @@ impl Headless {
         ctx.wait()
     }
 
-    fn render_frame(&mut self, ctx: &GpuContext, camera: &Camera) -> Result<(), GpuError> {
+    fn render_frame(&mut self, ctx: &GpuContext, camera: &impl ToView) -> Result<(), GpuError> {
         let view = self
             .target
             .create_view(&wgpu::TextureViewDescriptor::default());
@@ -111,7 +111,7 @@ impl Headless {
     pub fn time_frames(
         &mut self,
         ctx: &GpuContext,
-        camera: &Camera,
+        camera: &impl ToView,
         warmup: u32,
         frames: u32,
     ) -> Result<FrameTimes, GpuError> {

@@ -28,12 +28,14 @@ use super::settings::GpuSettings;
 use super::shaders::Background;
 pub use super::terrain_pass::PASS_TERRAIN;
 use super::terrain_pass::TerrainPass;
+/// The format of [`CloudRenderer::render_clouds`]'s texture.
+pub use super::textures::CLOUD_FORMAT as CLOUDS_ONLY_FORMAT;
 pub use super::tsaa::PASS_TSAA;
 use super::tsaa::{TsaaPass, is_cut, jitter};
-use super::uniforms::{FrameInputs, FrameUniforms, view_projection};
+use super::uniforms::{FrameInputs, FrameUniforms};
 use super::{bind, bind::Recorder};
+use crate::render::camera::{ToView, View};
 use crate::render::cloud_map::CloudMap;
-use crate::render::cpu::camera::Camera;
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
 
@@ -120,7 +122,7 @@ pub struct CloudRenderer {
     clouds: CloudPass,
     tsaa: Option<TsaaPass>,
     composite: CompositePass,
-    prev_camera: Option<Camera>,
+    prev_view: Option<View>,
     prev_view_proj: Mat4,
     frame_index: u32,
     timestamps: Option<wgpu::QuerySet>,
@@ -157,7 +159,7 @@ impl CloudRenderer {
             settings: *settings,
             width: size.0,
             height: size.1,
-            prev_camera: None,
+            prev_view: None,
             prev_view_proj: Mat4::IDENTITY,
             frame_index: 0,
             timestamps: None,
@@ -330,44 +332,41 @@ impl CloudRenderer {
     /// Records one frame into `encoder`: the clouds (and sky, sun and
     /// terrain) seen by `camera` into `target` (a view of a texture of the
     /// size given to [`Self::resize`] and the format given to
-    /// [`Self::new`]). With `depth` (a single-sampled depth texture of the
-    /// same size, written with [`super::uniforms::view_projection`]'s
-    /// convention, and `TEXTURE_BINDING` usage), pixels with geometry keep
-    /// their colour and only the clouds in front of it are blended over
-    /// them; pixels at the far plane (1.0) get sky and clouds. The scene's
-    /// own terrain takes the place of `depth` when it has one.
+    /// [`Self::new`]). `camera` is the scene's [`crate::render::camera::Camera`] or the
+    /// application's own [`View`] (its view and projection matrices; see
+    /// [`crate::render::camera`] for the conventions).
+    ///
+    /// With `depth` (a single-sampled depth texture of the same size with
+    /// `TEXTURE_BINDING` usage, written with the same projection as
+    /// `camera`: standard or reversed, finite or infinite far plane),
+    /// pixels with geometry keep their colour and only the clouds in front
+    /// of it are blended over them; pixels at the far value (what the
+    /// buffer is cleared to: 1, or 0 reversed) get sky and clouds. The
+    /// scene's own terrain takes the place of `depth` when it has one.
     pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
         depth: Option<&wgpu::TextureView>,
-        camera: &Camera,
+        camera: &impl ToView,
     ) -> Result<(), RenderError> {
         self.last_passes.clear();
         if self.width == 0 || self.height == 0 {
             return Ok(());
         }
-        self.check_inputs(target, depth)?;
-        let view_proj = self.write_uniforms(camera);
+        self.check_target(target)?;
+        self.check_depth(depth)?;
+        let view = self.view_of(camera);
+        self.write_uniforms(&view, self.terrain.is_some());
         let constants = self.settings.constants();
-        let mut rec = Recorder::new(encoder, self.timestamps.as_ref());
+        // A handle (wgpu objects are reference-counted), so `self` stays free.
+        let timestamps = self.timestamps.clone();
+        let mut rec = Recorder::new(encoder, timestamps.as_ref());
         if let Some(t) = &self.terrain {
             t.record(&mut rec, &self.inputs, self.settings.quality.max_distance_m);
         }
         let own_depth = self.terrain.as_ref().map(|t| bind::view(&t.depth));
-        let distance = self.tsaa.as_ref().map(|t| bind::view(&t.distance));
-        let layer = self.clouds.record(
-            &mut rec,
-            &self.device,
-            &self.inputs,
-            &constants,
-            own_depth.as_ref().or(depth),
-            distance.as_ref(),
-        );
-        let resolved = match &mut self.tsaa {
-            Some(t) => t.record(&mut rec, &self.device, &self.inputs, &layer),
-            None => layer,
-        };
+        let resolved = self.record_clouds(&mut rec, &constants, own_depth.as_ref().or(depth));
         let terrain_color = self.terrain.as_ref().map(|t| bind::view(&t.color));
         let (background, behind) = match (&terrain_color, depth) {
             (Some(c), _) => (Background::Terrain, Some(c)),
@@ -385,18 +384,107 @@ impl CloudRenderer {
             behind,
         );
         self.last_passes = rec.passes();
-        self.prev_camera = Some(*camera);
-        self.prev_view_proj = view_proj;
-        self.frame_index = self.frame_index.wrapping_add(1);
         Ok(())
     }
 
-    /// The target's format and the depth buffer's format and size.
-    fn check_inputs(
-        &self,
-        target: &wgpu::TextureView,
+    /// Records the clouds alone, for an engine that composites them in its
+    /// own HDR pipeline, and returns the texture they are in (valid until
+    /// the next `render` or `render_clouds`; [`CLOUDS_ONLY_FORMAT`],
+    /// `TEXTURE_BINDING | COPY_SRC`, the size given to [`Self::resize`];
+    /// `None` while that size is zero).
+    ///
+    /// Each texel is linear and premultiplied: `rgb` the clouds' radiance
+    /// (sunlight of [`crate::render::cpu::renderer::SUN_INTENSITY`], no
+    /// exposure and no tone map applied; the haze in front of the clouds
+    /// included), `a` their opacity, one minus the transmittance. The
+    /// engine's own colour `c` behind becomes `rgb + (1 - a) · c`; with
+    /// TSAA on, the texture is the resolved history. No sky, sun disk or
+    /// terrain is drawn, and the scene's terrain is not marched to: the
+    /// clouds stop at `depth` (as in [`Self::render`]) or at the longest
+    /// ray.
+    ///
+    /// ```no_run
+    /// # fn frame(
+    /// #     clouds: &mut cumulus::render::gpu::CloudRenderer,
+    /// #     device: &wgpu::Device,
+    /// #     queue: &wgpu::Queue,
+    /// #     depth: &wgpu::TextureView,
+    /// #     view_matrix: glam::Mat4,
+    /// #     projection: glam::Mat4,
+    /// # ) -> Result<(), Box<dyn std::error::Error>> {
+    /// use cumulus::render::camera::View;
+    ///
+    /// // The engine's camera: any perspective (here whatever it uses,
+    /// // reversed-Z or not), and the depth buffer it drew its scene with.
+    /// let view = View::new(view_matrix, projection)?;
+    /// let mut encoder = device.create_command_encoder(&Default::default());
+    /// if let Some(layer) = clouds.render_clouds(&mut encoder, Some(depth), &view)? {
+    ///     let _clouds = layer.create_view(&Default::default());
+    ///     // ... bind `_clouds` in the engine's HDR pass:
+    ///     // colour = clouds.rgb + (1 - clouds.a) * colour
+    /// }
+    /// queue.submit([encoder.finish()]);
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn render_clouds(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
         depth: Option<&wgpu::TextureView>,
-    ) -> Result<(), RenderError> {
+        camera: &impl ToView,
+    ) -> Result<Option<&wgpu::Texture>, RenderError> {
+        self.last_passes.clear();
+        if self.width == 0 || self.height == 0 {
+            return Ok(None);
+        }
+        self.check_depth(depth)?;
+        let view = self.view_of(camera);
+        self.write_uniforms(&view, false);
+        let constants = self.settings.constants();
+        // A handle (wgpu objects are reference-counted), so `self` stays free.
+        let timestamps = self.timestamps.clone();
+        let mut rec = Recorder::new(encoder, timestamps.as_ref());
+        self.record_clouds(&mut rec, &constants, depth);
+        self.last_passes = rec.passes();
+        Ok(Some(match &self.tsaa {
+            Some(t) => t.latest(),
+            None => &self.clouds.layer,
+        }))
+    }
+
+    /// The view `camera` gives at this target's aspect.
+    fn view_of(&self, camera: &impl ToView) -> View {
+        let aspect = self.width as f32 / self.height as f32;
+        camera.to_view(aspect, self.settings.quality.max_distance_m)
+    }
+
+    /// The cloud pass up to `depth` and, with TSAA, the resolve; returns
+    /// the resolved layer. Moves the frame on (history, jitter).
+    fn record_clouds(
+        &mut self,
+        rec: &mut Recorder,
+        constants: &[(&str, f64)],
+        depth: Option<&wgpu::TextureView>,
+    ) -> wgpu::TextureView {
+        let distance = self.tsaa.as_ref().map(|t| bind::view(&t.distance));
+        let layer = self.clouds.record(
+            rec,
+            &self.device,
+            &self.inputs,
+            constants,
+            depth,
+            distance.as_ref(),
+        );
+        let resolved = match &mut self.tsaa {
+            Some(t) => t.record(rec, &self.device, &self.inputs, &layer),
+            None => layer,
+        };
+        self.frame_index = self.frame_index.wrapping_add(1);
+        resolved
+    }
+
+    /// The target's format.
+    fn check_target(&self, target: &wgpu::TextureView) -> Result<(), RenderError> {
         let tf = target.texture().format();
         if tf != self.target_format {
             return Err(RenderError::TargetFormat {
@@ -404,6 +492,11 @@ impl CloudRenderer {
                 expected: self.target_format,
             });
         }
+        Ok(())
+    }
+
+    /// The depth buffer's format and size.
+    fn check_depth(&self, depth: Option<&wgpu::TextureView>) -> Result<(), RenderError> {
         if let Some(d) = depth {
             let t = d.texture();
             if !t.format().is_depth_stencil_format() {
@@ -421,10 +514,12 @@ impl CloudRenderer {
         Ok(())
     }
 
-    /// Writes the frame's uniforms (a camera cut resets the history, and
-    /// TSAA jitters the rays); returns the frame's view-projection.
-    fn write_uniforms(&mut self, camera: &Camera) -> Mat4 {
-        let cut = self.prev_camera.is_none_or(|p| is_cut(&p, camera));
+    /// Writes the frame's uniforms for `view` (a camera cut resets the
+    /// history, and TSAA jitters the rays); `own_depth`: the cloud pass
+    /// reads the terrain's depth buffer (stored flipped under reversed
+    /// depth).
+    fn write_uniforms(&mut self, view: &View, own_depth: bool) {
+        let cut = self.prev_view.is_none_or(|p| is_cut(&p, view));
         let (jit, blend) = match &mut self.tsaa {
             Some(t) => {
                 if cut {
@@ -434,14 +529,14 @@ impl CloudRenderer {
             }
             None => ([0.0; 3], 1.0),
         };
-        let aspect = self.width as f32 / self.height as f32;
-        let view_proj = view_projection(camera, aspect, self.settings.quality.max_distance_m);
+        let view_proj = view.view_projection();
         let terrain = self
             .terrain
             .as_ref()
             .map_or([0.0; 2], |t| [t.extent_m, t.max_m]);
         let u = FrameUniforms::new(&FrameInputs {
-            camera: *camera,
+            view: *view,
+            depth_flipped: own_depth && view.reversed_depth(),
             prev_view_proj: if cut { view_proj } else { self.prev_view_proj },
             width: self.width,
             height: self.height,
@@ -458,6 +553,7 @@ impl CloudRenderer {
         });
         self.queue
             .write_buffer(&self.inputs.uniforms, 0, bytemuck::bytes_of(&u));
-        view_proj
+        self.prev_view = Some(*view);
+        self.prev_view_proj = view_proj;
     }
 }

@@ -35,7 +35,7 @@ pub fn cloud_pass(depth: bool, tsaa: bool) -> String {
     ));
     if depth {
         s.push_str(
-            "    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if d < 1.0 {\n        max_t = min(max_t, depth_to_distance(d, camera_ray(pos.xy)));\n    }\n",
+            "    let z = view_depth(textureLoad(depth_tex, vec2i(pos.xy), 0));\n    if is_geometry(z) {\n        max_t = min(max_t, depth_to_distance(z, pos.xy));\n    }\n",
         );
     }
     s.push_str("    let c = cloud_pixel(pos.xy, max_t);\n");
@@ -70,7 +70,7 @@ pub fn composite_pass(background: Background) -> String {
             "@group(1) @binding(1) var background_tex: texture_2d<f32>;\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let b = textureLoad(background_tex, vec2i(pos.xy), 0);\n    var bg = sky_background(pos.xy);\n    if b.a > 0.5 {\n        bg = b.rgb;\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * bg), 1.0);\n}\n",
         ),
         Background::ExternalDepth => s.push_str(
-            "@group(1) @binding(1) var depth_tex: texture_depth_2d;\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if d < 1.0 {\n        return vec4f(display(c.rgb), c.a);\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);\n}\n",
+            "@group(1) @binding(1) var depth_tex: texture_depth_2d;\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if is_geometry(d) {\n        return vec4f(display(c.rgb), c.a);\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);\n}\n",
         ),
     }
     s

@@ -6,7 +6,7 @@ use super::bind::{self, FILTERABLE, Recorder, UNFILTERABLE};
 use super::inputs::Inputs;
 use super::shaders;
 use super::textures::{self, CLOUD_FORMAT, DISTANCE_FORMAT};
-use crate::render::cpu::camera::Camera;
+use crate::render::camera::View;
 
 /// The pass's name.
 pub const PASS_TSAA: &str = "tsaa";
@@ -41,12 +41,15 @@ pub const CUT_DISTANCE_M: f32 = 500.0;
 pub const CUT_ANGLE_DEG: f32 = 30.0;
 
 /// Whether going from `a` to `b` in one frame is a camera cut.
-pub fn is_cut(a: &Camera, b: &Camera) -> bool {
-    let (fa, _, _) = a.basis();
-    let (fb, _, _) = b.basis();
-    a.position_m.distance(b.position_m) > CUT_DISTANCE_M
-        || fa.dot(fb).clamp(-1.0, 1.0).acos().to_degrees() > CUT_ANGLE_DEG
-        || (a.fov_deg - b.fov_deg).abs() > 1.0
+pub fn is_cut(a: &View, b: &View) -> bool {
+    a.eye().distance(b.eye()) > CUT_DISTANCE_M
+        || a.forward()
+            .dot(b.forward())
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees()
+            > CUT_ANGLE_DEG
+        || (a.vertical_fov_deg() - b.vertical_fov_deg()).abs() > 1.0
 }
 
 /// TSAA settings.
@@ -142,6 +145,11 @@ impl TsaaPass {
         } else {
             self.settings.blend.clamp(1e-3, 1.0)
         }
+    }
+
+    /// The history texture written last (the resolved clouds).
+    pub fn latest(&self) -> &wgpu::Texture {
+        &self.history[self.latest]
     }
 
     /// Records the pass: blends `clouds` into the history and returns the

@@ -1,0 +1,123 @@
+"""Rewrites the README's tables of numbers from what docs/regenerate.sh made.
+
+    python3 docs/readme_tables.py STATS_DIR
+
+- "Error against cost (rendering)": docs/render_quality/render_quality.csv
+  (its rows of 8, 16, 32, 48, 64, 128 and 256 steps; the default, 48, bold);
+- "Error against run time (physics)": docs/convergence/convergence.csv (its
+  rows of dt 0.1, 0.5, 1, 2, 5, 10, 60 and 600 s; the default, 5 s, bold);
+- "Cloud-field statistics": the `cumulus stats` output saved as
+  STATS_DIR/NAME.txt for fair_weather and bomex.
+
+Only the rows of those tables change; the text around them is left alone
+(say in it what changed). tests/docs_numbers.rs checks the result.
+"""
+
+import csv
+import math
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def sig(v, digits=2):
+    """`v` with `digits` significant figures, plain decimal (0 for 0)."""
+    if v == 0:
+        return "0"
+    decimals = max(0, digits - 1 - int(math.floor(math.log10(abs(v)))))
+    return f"{v:.{decimals}f}"
+
+
+def replace_table(text, marker, rows):
+    """Replaces the body rows of the first table after `marker`."""
+    start = text.index(marker)
+    lines = text[start:].split("\n")
+    i = next(k for k, l in enumerate(lines) if l.startswith("|"))
+    j = i
+    while j < len(lines) and lines[j].startswith("|"):
+        j += 1
+    body = ["| " + " | ".join(r) + " |" for r in rows]
+    lines[i + 2 : j] = body
+    return text[:start] + "\n".join(lines)
+
+
+def bold(cells):
+    return [f"**{c}**" for c in cells]
+
+
+def render_quality_rows():
+    rows = list(csv.DictReader(open(ROOT / "docs/render_quality/render_quality.csv")))
+    out = []
+    for r in rows:
+        steps = int(r["steps"])
+        if steps not in (8, 16, 32, 48, 64, 128, 256):
+            continue
+        cells = [
+            str(steps),
+            f"{float(r['wall_s']):.2f}",
+            f"{float(r['mean_abs_error']):.4f}",
+            f"{float(r['max_abs_error']):.2f}",
+        ]
+        out.append(bold(cells) if steps == 48 else cells)
+    return out
+
+
+def convergence_rows():
+    rows = list(csv.DictReader(open(ROOT / "docs/convergence/convergence.csv")))
+    out = []
+    cols = [
+        "err_z_m",
+        "err_w_mps",
+        "err_theta_v_K",
+        "err_qc_gkg",
+        "err_cloud_base_m",
+        "err_cloud_top_m",
+    ]
+    for r in rows:
+        dt = float(r["dt_s"])
+        if dt not in (0.1, 0.5, 1, 2, 5, 10, 60, 600):
+            continue
+        life = float(r["life_mismatch"])
+        cells = [r["dt_s"], sig(float(r["wall_s"]))]
+        cells += [sig(float(r[c]), 3 if float(r[c]) >= 10 else 2) for c in cols]
+        cells.append("0" if life == 0 else f"{life:.4f}")
+        out.append(bold(cells) if dt == 5 else cells)
+    return out
+
+
+def stats_rows(stats_dir):
+    out = []
+    for name in ("fair_weather", "bomex"):
+        text = (Path(stats_dir) / f"{name}.txt").read_text()
+        cf = float(re.search(r"cloud_fraction=([-0-9.]+)", text).group(1))
+        d = float(re.search(r"area_perimeter_dimension=([-0-9.]+)", text).group(1))
+        m = re.search(r"size_density_exponent=([-0-9.]+) over ([0-9.]+) decades", text)
+        out.append(
+            [
+                f"`{name}.toml`",
+                f"{cf:.3f}",
+                f"{d:.2f}",
+                f"{float(m.group(1)):.2f} ({float(m.group(2)):.1f})",
+            ]
+        )
+    return out
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: python3 docs/readme_tables.py STATS_DIR")
+    path = ROOT / "README.md"
+    text = path.read_text()
+    text = replace_table(text, "### Error against cost (rendering)", render_quality_rows())
+    text = replace_table(text, "## Error against run time (physics)", convergence_rows())
+    text = replace_table(text, "Today's fields (", stats_rows(sys.argv[1]))
+    tmp = path.with_suffix(".md.tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+    print("README.md: tables rewritten")
+
+
+if __name__ == "__main__":
+    main()

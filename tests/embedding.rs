@@ -1,0 +1,316 @@
+//! What an engine embedding the renderer needs: its own view and
+//! projection matrices (roll, off-axis, right-handed), its depth buffer in
+//! any of the common conventions (standard or reversed, finite or infinite
+//! far plane), and the clouds-only output it composites itself. GPU tests
+//! skip without an adapter unless `CUMULUS_REQUIRE_GPU=1` (CI: lavapipe).
+
+mod common;
+
+use common::gpu;
+use cumulus::prepare::Prepared;
+use cumulus::render::camera::View;
+use cumulus::render::cpu::renderer::{render_clouds_linear, to_srgb8};
+use cumulus::render::cpu::sky::{sky_radiance, sun_direction, sun_disk};
+use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
+use cumulus::render::gpu::{CloudRenderer, GpuContext, textures};
+use cumulus::scene::Scene;
+use glam::{Mat4, Vec3, Vec4};
+
+const W: u32 = 96;
+const H: u32 = 64;
+
+fn prepared() -> (Scene, Prepared) {
+    let mut sc =
+        Scene::load(std::path::Path::new("scenes/fair_weather.toml")).expect("shipped scene");
+    sc.render.tsaa = false;
+    sc.render.width = W;
+    sc.render.height = H;
+    let p = Prepared::from_scene(&sc, || {}).expect("prepare");
+    (sc, p)
+}
+
+fn renderer(ctx: &GpuContext, sc: &Scene, p: &Prepared) -> CloudRenderer {
+    let r = &sc.render;
+    let mut c = CloudRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+        &p.gpu_settings(r, r.quality()),
+        &p.cloud_map,
+        None,
+    );
+    c.update_field(&ctx.queue, &p.field);
+    c.resize(W, H);
+    c
+}
+
+/// A depth buffer cleared to `value` everywhere: a plane of constant
+/// camera-space depth, in whatever convention `value` was computed in.
+fn depth_buffer(ctx: &GpuContext, value: f32) -> wgpu::Texture {
+    let t = textures::create_2d(
+        &ctx.device,
+        "app.depth",
+        W,
+        H,
+        wgpu::TextureFormat::Depth32Float,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    );
+    let view = t.create_view(&Default::default());
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("app.clear"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(value),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    ctx.queue.submit([enc.finish()]);
+    t
+}
+
+/// The clouds-only layer for `view` up to `depth`.
+fn clouds_only(
+    ctx: &GpuContext,
+    c: &mut CloudRenderer,
+    depth: Option<&wgpu::Texture>,
+    view: &View,
+) -> Vec<[f32; 4]> {
+    let dv = depth.map(|d| d.create_view(&Default::default()));
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    let tex = c
+        .render_clouds(&mut enc, dv.as_ref(), view)
+        .expect("frame")
+        .expect("non-zero size")
+        .clone();
+    ctx.queue.submit([enc.finish()]);
+    assert_eq!(tex.format(), CLOUDS_ONLY_FORMAT);
+    ctx.read_rgba16f(&tex).expect("readback")
+}
+
+fn mean_abs(a: &[[f32; 4]], b: &[[f32; 4]], lane: usize) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x[lane] - y[lane]).abs() as f64)
+        .sum::<f64>()
+        / a.len() as f64
+}
+
+fn opacity(a: &[[f32; 4]]) -> f64 {
+    a.iter().map(|p| p[3] as f64).sum()
+}
+
+/// A right-handed view rolled by 25°, with an off-axis reversed-Z
+/// infinite projection: the kind of camera a flight simulator's cockpit
+/// window has, and nothing like the scene's yaw/pitch camera.
+fn engine_view(sc: &Scene) -> View {
+    let c = sc.render.camera();
+    let (f, _, u) = c.basis();
+    let up = glam::Quat::from_axis_angle(f, 25_f32.to_radians()) * u;
+    let world_to_view = Mat4::look_to_rh(c.position_m, f, up);
+    // perspective_infinite_reverse_rh, its centre shifted by a fifth of the
+    // screen right and a tenth down (clip x += 0.2 w, y -= 0.1 w).
+    let p = Mat4::perspective_infinite_reverse_rh(55_f32.to_radians(), W as f32 / H as f32, 0.3);
+    let shift = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::Z, Vec4::new(0.2, -0.1, 0.0, 1.0));
+    View::new(world_to_view, shift * p).expect("a valid camera")
+}
+
+/// The GPU's clouds-only output against its CPU twin, for an engine's
+/// rolled, off-axis, right-handed, reversed-Z infinite camera: the same
+/// rays on both sides, so the layers agree as closely as the composited
+/// pictures do (`tests/render_gpu.rs`, mean under half an 8-bit level).
+#[test]
+fn an_engines_camera_gives_the_cpu_twins_clouds() {
+    let Some(ctx) = gpu() else { return };
+    let (sc, p) = prepared();
+    let view = engine_view(&sc);
+    let mut c = renderer(&ctx, &sc, &p);
+    let gpu = clouds_only(&ctx, &mut c, None, &view);
+    let mut fr = p.frame(&sc.render, sc.render.quality());
+    fr.view = view;
+    let cpu: Vec<[f32; 4]> = render_clouds_linear(W, H, &fr, 1)
+        .iter()
+        .map(|v| v.to_array())
+        .collect();
+    let alpha = mean_abs(&gpu, &cpu, 3);
+    let red = mean_abs(&gpu, &cpu, 0);
+    let cover = opacity(&cpu) / cpu.len() as f64;
+    eprintln!("opacity: mean {cover:.3}; GPU-CPU mean |Δα| {alpha:.5}, |Δr| {red:.5}");
+    assert!(cover > 0.05, "the view sees clouds: mean opacity {cover}");
+    assert!(alpha < 0.004, "mean |Δ opacity| {alpha}");
+    assert!(red < 0.01, "mean |Δ red| {red}");
+    // The roll is real: the scene's own camera sees other clouds where.
+    let plain = clouds_only(
+        &ctx,
+        &mut c,
+        None,
+        &sc.render.camera().view(W as f32 / H as f32, 4e4),
+    );
+    assert!(
+        mean_abs(&gpu, &plain, 3) > 0.02,
+        "rolled view = unrolled view"
+    );
+}
+
+/// One wall of constant camera depth 3.5 km, written as four engines
+/// would write it; each hides the same clouds. Before this test the
+/// renderer read every depth buffer as standard-Z with its own near and
+/// far planes, so the reversed ones hid nothing (0 reads as the near
+/// plane) or everything.
+#[test]
+fn every_depth_convention_hides_the_same_clouds() {
+    let Some(ctx) = gpu() else { return };
+    let (sc, p) = prepared();
+    let mut c = renderer(&ctx, &sc, &p);
+    let cam = sc.render.camera();
+    let (f, _, _) = cam.basis();
+    let aspect = W as f32 / H as f32;
+    let fov = cam.fov_deg.to_radians();
+    let wall_m = 3500.0_f32;
+    let lh = Mat4::look_to_lh(cam.position_m, f, Vec3::Y);
+    let rh = Mat4::look_to_rh(cam.position_m, f, Vec3::Y);
+    let views = [
+        (
+            "lh standard",
+            lh,
+            Mat4::perspective_lh(fov, aspect, 1.0, 40_000.0),
+        ),
+        (
+            "rh standard",
+            rh,
+            Mat4::perspective_rh(fov, aspect, 0.1, 60_000.0),
+        ),
+        (
+            "rh reversed infinite",
+            rh,
+            Mat4::perspective_infinite_reverse_rh(fov, aspect, 0.1),
+        ),
+        (
+            "lh infinite",
+            lh,
+            Mat4::perspective_infinite_lh(fov, aspect, 0.5),
+        ),
+    ];
+    let mut first: Option<Vec<[f32; 4]>> = None;
+    for (name, m, proj) in views {
+        let view = View::new(m, proj).expect("valid");
+        // The depth the projection gives a point `wall_m` ahead on the axis.
+        let ahead = view.eye() + f * wall_m;
+        let clip = view.view_projection() * ahead.extend(1.0);
+        let d = clip.z / clip.w;
+        let free = clouds_only(&ctx, &mut c, None, &view);
+        let far = clouds_only(
+            &ctx,
+            &mut c,
+            Some(&depth_buffer(&ctx, view.far_depth())),
+            &view,
+        );
+        assert!(
+            mean_abs(&far, &free, 3) < 1e-3,
+            "{name}: a depth buffer cleared to the far value {} hides clouds",
+            view.far_depth()
+        );
+        let mut walled = clouds_only(&ctx, &mut c, Some(&depth_buffer(&ctx, d)), &view);
+        let (o, o_free) = (opacity(&walled), opacity(&free));
+        eprintln!("{name}: depth {d:.6}: opacity {o:.1} of {o_free:.1} without the wall");
+        assert!(
+            o < 0.8 * o_free && o > 0.05 * o_free,
+            "{name}: the wall at {wall_m} m should hide part of the clouds: {o} of {o_free}"
+        );
+        // A right-handed camera with +y up sees the world mirrored.
+        if name.starts_with("rh") {
+            mirror(&mut walled);
+        }
+        match &first {
+            None => first = Some(walled),
+            Some(a) => {
+                let e = mean_abs(a, &walled, 3);
+                assert!(e < 2e-3, "{name}: differs from the first convention by {e}");
+            }
+        }
+    }
+}
+
+/// Flips a `W x H` image left-right.
+fn mirror(img: &mut [[f32; 4]]) {
+    for row in img.chunks_exact_mut(W as usize) {
+        row.reverse();
+    }
+}
+
+/// The clouds-only layer composited over the analytic sky on the CPU
+/// (`rgb + (1 - a) · sky`, tone-mapped) is the renderer's own composite:
+/// the output is linear, premultiplied, and leaves the background out.
+#[test]
+fn the_clouds_only_layer_composites_to_the_renderers_picture() {
+    let Some(ctx) = gpu() else { return };
+    let (sc, p) = prepared();
+    let mut c = renderer(&ctx, &sc, &p);
+    let r = &sc.render;
+    let view = r
+        .camera()
+        .view(W as f32 / H as f32, r.quality().max_distance_m);
+    let layer = clouds_only(&ctx, &mut c, None, &view);
+    let target = textures::create_2d(
+        &ctx.device,
+        "app.target",
+        W,
+        H,
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    c.render(
+        &mut enc,
+        &target.create_view(&Default::default()),
+        None,
+        &view,
+    )
+    .expect("frame");
+    ctx.queue.submit([enc.finish()]);
+    let picture: Vec<u8> = ctx
+        .read_texture(&target, 4)
+        .expect("readback")
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
+    let composited: Vec<Vec3> = layer
+        .iter()
+        .enumerate()
+        .map(|(k, px)| {
+            let (x, y) = ((k as u32 % W) as f32 + 0.5, (k as u32 / W) as f32 + 0.5);
+            let dir = view.camera_ray(x, y, W, H);
+            let sky = sky_radiance(dir, sun) + sun_disk(dir, sun);
+            Vec3::new(px[0], px[1], px[2]) + (1.0 - px[3]) * sky
+        })
+        .collect();
+    let ours = to_srgb8(&composited, r.quality().exposure);
+    let worst = ours
+        .iter()
+        .zip(&picture)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    let cloudy = layer.iter().filter(|p| p[3] > 0.5).count();
+    assert!(cloudy > 50, "{cloudy} cloudy pixels");
+    // Half floats (10-bit mantissa) and the GPU's exp: two 8-bit levels.
+    assert!(worst <= 2, "composite differs by {worst} levels");
+    // And it is not the composite itself: no sky in the clear pixels.
+    let clear = layer.iter().filter(|p| p[3] < 1e-3).count();
+    let dark = layer
+        .iter()
+        .filter(|p| p[3] < 1e-3 && p[0].abs() + p[1].abs() + p[2].abs() < 1e-4)
+        .count();
+    assert!(
+        clear > 50 && dark == clear,
+        "{dark} of {clear} clear pixels are black"
+    );
+}
