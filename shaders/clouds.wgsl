@@ -17,6 +17,8 @@ override DEBUG_COUNT: bool = false;
 
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
+const SURFACE_RAMP: f32 = 0.08;
+const DETAIL_CONTRAST: f32 = 2.6;
 const REFINE: u32 = 4u;
 const ALBEDO: f32 = 0.99;
 const MIN_TRANSMITTANCE: f32 = 0.01;
@@ -107,7 +109,9 @@ fn value_noise3(q: vec3f, period: i32) -> f32 {
 
 fn detail_noise(p: vec3f, scale_m: f32) -> f32 {
     let q = p / scale_m;
-    return 0.65 * value_noise3(q, 64) + 0.35 * value_noise3(q * 2.0 + vec3f(17.3), 128);
+    return 0.5 * value_noise3(q, 64)
+        + 0.3 * value_noise3(q * 2.0 + vec3f(17.3), 128)
+        + 0.2 * value_noise3(q * 4.0 + vec3f(5.9), 256);
 }
 
 // True where the coarse max-coverage mask says no P texel near `(x, z)`
@@ -125,24 +129,37 @@ fn coarse_empty(x: f32, z: f32) -> bool {
     return textureLoad(mask_tex, c, 0).r == 0u;
 }
 
-// (shape, local top, fill) of the cloud footprint at map coordinate uv.
-fn footprint(u: f32, v: f32) -> vec3f {
+// (cover, local top, fill, map value) at map coordinate uv (the CPU's
+// `footprint`).
+fn footprint(u: f32, v: f32) -> vec4f {
     let pf = textureSampleLevel(p_tex, wrap_linear, vec2f(u, v), 0.0);
     if pf.r <= 1e-3 {
-        return vec3f(0.0);
+        return vec4f(0.0);
     }
     let cm = textureSampleLevel(cm_tex, wrap_linear, vec2f(u, v), 0.0);
-    let cov = clamp(frame.band.z * pf.r, 0.0, 1.0);
-    let shape = clamp((cm.r - (1.0 - cov)) / max(cov, 1e-3), 0.0, 1.0);
-    if shape <= 0.0 {
-        return vec3f(0.0);
-    }
-    let top = clamp(0.15 + 0.85 * pf.g, 0.0, 1.0) * sqrt(shape) * (0.75 + 0.25 * cm.g);
-    return vec3f(shape, top, pf.b);
+    let cover = clamp(frame.band.z * pf.r, 0.0, 1.0);
+    let top = clamp(0.2 + 0.8 * pf.g, 0.0, 1.0) * (0.7 + 0.3 * cm.g);
+    return vec4f(cover, top, pf.b, cm.r);
 }
 
-// Extinction sigma_t (1/m) at p; `detail` false leaves out the detail noise
-// (shadow rays).
+// The threshold the cloud field must exceed (the CPU's
+// `cumulus_threshold`): lowest just above the flat base, a dome rising to
+// 1 at the local top.
+fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
+    let t = eta / top;
+    return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0);
+}
+
+// The map value and the 3D noise mixed by `s`, the noise's contrast
+// widened, the mix's spread restored (the CPU's `cloud_field`).
+fn cloud_field(m: f32, n: f32, s: f32) -> f32 {
+    let nn = clamp(0.5 + (n - 0.5) * DETAIL_CONTRAST, 0.0, 1.0);
+    let norm = max(sqrt((1.0 - s) * (1.0 - s) + s * s), 1e-3);
+    return 0.5 + ((1.0 - s) * (m - 0.5) + s * (nn - 0.5)) / norm;
+}
+
+// Extinction sigma_t (1/m) at p; `detail` false puts the detail noise's
+// mean in its place (shadow rays).
 fn density_at(p: vec3f, detail: bool) -> f32 {
     let eta = height_fraction(p.y);
     if eta < 0.0 || eta > 1.0 {
@@ -151,33 +168,20 @@ fn density_at(p: vec3f, detail: bool) -> f32 {
     if coarse_empty(p.x, p.z) {
         return 0.0;
     }
-    let strength = frame.map.y;
-    let scale = frame.map.z;
-    var x = p.x;
-    var z = p.z;
-    var n = 0.0;
-    let with_detail = DETAIL && detail;
-    if with_detail {
-        n = detail_noise(p, scale);
-        let warp = scale * strength;
-        x += (n - 0.5) * 2.0 * warp;
-        z += (value_noise3(p / scale + vec3f(31.1), 64) - 0.5) * 2.0 * warp;
-    }
-    let fp = footprint(x / frame.map.x, z / frame.map.x);
-    var top = fp.y;
-    if with_detail {
-        top *= 1.0 - 0.3 * strength * n;
-    }
-    if fp.x <= 0.0 || eta >= top {
+    let fp = footprint(p.x / frame.map.x, p.z / frame.map.x);
+    if fp.x <= 0.0 || eta >= fp.y {
         return 0.0;
     }
-    let base = smoothstep(0.0, BASE_RAMP, eta);
-    let t = eta / top;
-    let dome = clamp((1.0 - t * t) * 3.0, 0.0, 1.0);
-    var profile = base * dome * min(fp.x * 4.0, 1.0);
-    if with_detail {
-        profile = max(profile - strength * n * (1.0 - profile), 0.0);
+    let threshold = cumulus_threshold(eta, fp.y, fp.x);
+    let s = frame.map.y;
+    if cloud_field(fp.w, 1.0, s) < threshold {
+        return 0.0;
     }
+    var n = 0.5;
+    if DETAIL && detail {
+        n = detail_noise(p, frame.map.z);
+    }
+    let profile = clamp((cloud_field(fp.w, n, s) - threshold) / SURFACE_RAMP, 0.0, 1.0);
     return frame.band.w * (0.3 + 0.7 * fp.z) * profile;
 }
 

@@ -11,13 +11,18 @@ use crate::render::cpu::density::Fields;
 use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::gpu::baseline::Sphere;
 use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless};
+use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::scene::{RenderSettings, Scene, SceneError};
 use crate::sim::{Band, FramePlan, Parcels, ProjectedField, Simulation};
 
 /// A scene's textures at one moment.
 pub struct Prepared {
+    /// P as the simulation projected it.
     pub field: ProjectedField,
+    /// P spread to the clouds' merging scale ([`soft_field`]): what the
+    /// density reads (the GPU renderer makes its own from `field`).
+    pub soft: ProjectedField,
     /// The parcels P was projected from (for the per-parcel baseline).
     pub parcels: Parcels,
     /// The projection's fill scale (`physics.fill_full_condensed_fraction`).
@@ -48,7 +53,9 @@ impl Prepared {
         }
         let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
         sim.project_into(&mut field, band);
+        let soft = soft_field(&field, SPREAD_M, l as f32);
         Ok(Self {
+            soft,
             parcels: sim.parcels().clone(),
             fill_full_condensed_fraction: scene.physics.fill_full_condensed_fraction,
             field,
@@ -98,7 +105,7 @@ impl Prepared {
             sun_elevation_deg: r.sun_elevation_deg,
             sun_azimuth_deg: r.sun_azimuth_deg,
             fields: Fields {
-                p: &self.field,
+                p: &self.soft,
                 cloud_map: &self.cloud_map,
             },
             density: r.density(self.band, self.map_extent_m),

@@ -231,8 +231,13 @@ fn every_depth_convention_hides_the_same_clouds() {
         match &first {
             None => first = Some(walled),
             Some(a) => {
+                // Standard f32 depth with a 0.1 m near plane places a wall
+                // 3.5 km away only to ~8 m (ulp 6e-8 of 1 - d = 2.7e-5),
+                // which moves the clouds cut at it: 5e-3 of mean opacity
+                // (2 % of the 0.25 the view has). Reading reversed depth
+                // as standard (the old code) changes it by ~0.17.
                 let e = mean_abs(a, &walled, 3);
-                assert!(e < 2e-3, "{name}: differs from the first convention by {e}");
+                assert!(e < 5e-3, "{name}: differs from the first convention by {e}");
             }
         }
     }
@@ -303,11 +308,13 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
     assert!(cloudy > 50, "{cloudy} cloudy pixels");
     // Half floats (10-bit mantissa) and the GPU's exp: two 8-bit levels.
     assert!(worst <= 2, "composite differs by {worst} levels");
-    // And it is not the composite itself: no sky in the clear pixels.
+    // And it is not the composite itself: no sky in the clear pixels (the
+    // sky's radiance is 0.1-1 here; a wisp of opacity under 1e-3 carries
+    // at most a few thousandths).
     let clear = layer.iter().filter(|p| p[3] < 1e-3).count();
     let dark = layer
         .iter()
-        .filter(|p| p[3] < 1e-3 && p[0].abs() + p[1].abs() + p[2].abs() < 1e-4)
+        .filter(|p| p[3] < 1e-3 && p[0].abs() + p[1].abs() + p[2].abs() < 0.01)
         .count();
     assert!(
         clear > 50 && dark == clear,

@@ -136,3 +136,62 @@ fn a_power_law_of_sizes_gives_its_exponent() {
     assert!(decades >= 2.0, "{decades} decades");
     assert!((slope + alpha).abs() < 0.15, "exponent {slope}");
 }
+
+/// The shipped trade-cumulus and fair-weather scenes, seen from above as
+/// `cumulus stats` sees them, are natural cumulus fields by the measures
+/// of `FieldStats::departures_from_nature` (before the multi-scale cloud
+/// map and the spread P: D 0.99-1.02, exponents -0.24 and -1.13, one size
+/// of blob). A field of discs of many sizes is not (its D against the
+/// same range).
+#[test]
+fn shipped_scenes_seen_from_above_are_natural_cumulus_fields_and_discs_are_not() {
+    use cumulus::prepare::Prepared;
+    use cumulus::report::field_stats::{column_field, field_stats};
+    use cumulus::scene::Scene;
+    for name in ["bomex", "fair_weather"] {
+        let sc = Scene::load(std::path::Path::new(&format!("scenes/{name}.toml")))
+            .expect("shipped scene");
+        let p = Prepared::from_scene(&sc, || {}).expect("prepare");
+        let r = &sc.render;
+        let s = field_stats(&column_field(&p.frame(r, r.quality()), 512, 48), 1.0, 4);
+        eprintln!(
+            "{name}: cloud fraction {:.3}, D {:?}, exponent {:?} over {:.1} decades",
+            s.cloud_fraction,
+            s.dimension,
+            s.size_fit.map(|f| f.slope),
+            s.size_decades
+        );
+        let off = s.departures_from_nature();
+        assert!(off.is_empty(), "{name}: {off:?}");
+    }
+    // Discs of many sizes drawn from a -2 power law: a natural exponent,
+    // but outlines of dimension 1.
+    let mut m = blank(1024, 1024);
+    let mut k = 0usize;
+    for (i, r) in [40.0, 25.0, 16.0, 10.0, 6.5, 4.0, 2.5].iter().enumerate() {
+        let count = 2usize.pow(i as u32 + 1);
+        for _ in 0..count {
+            // A deterministic scatter on a grid of slots.
+            let (cx, cy) = ((k * 97 % 1024) as f64 + 0.5, (k * 61 % 1024) as f64 + 0.5);
+            k += 1;
+            let rr = *r;
+            for y in (cy - rr) as i64..=(cy + rr) as i64 {
+                for x in (cx - rr) as i64..=(cx + rr) as i64 {
+                    let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+                    if dx * dx + dy * dy <= rr * rr {
+                        let (xx, yy) = (x.rem_euclid(1024) as usize, y.rem_euclid(1024) as usize);
+                        m.cells[yy * 1024 + xx] = true;
+                    }
+                }
+            }
+        }
+    }
+    let clouds = m.clouds();
+    let fit = area_perimeter_fit(&clouds, 4).expect("fit");
+    let d = 2.0 * fit.slope;
+    eprintln!("disc field: {} clouds, D = {d:.3}", clouds.len());
+    assert!(
+        !cumulus::report::field_stats::NATURAL_DIMENSION.contains(&d),
+        "discs: D = {d}"
+    );
+}

@@ -44,11 +44,11 @@ fn density_is_zero_outside_the_band_and_where_coverage_is_zero() {
     for i in 0..2000 {
         let (x, z) = ((i * 37 % 1000) as f32 * 10.0, (i * 91 % 1000) as f32 * 10.0);
         for y in [0.0, 599.0, 1601.0, 5000.0] {
-            assert_eq!(density_at(Vec3::new(x, y, z), &f, &D), 0.0);
+            assert_eq!(density_at(Vec3::new(x, y, z), &f, &D, true), 0.0);
         }
         let p = Vec3::new(x, 700.0, z);
-        assert_eq!(density_at(p, &e, &D), 0.0);
-        inside += usize::from(density_at(p, &f, &D) > 0.0);
+        assert_eq!(density_at(p, &e, &D, true), 0.0);
+        inside += usize::from(density_at(p, &f, &D, true) > 0.0);
     }
     assert!(
         inside > 200,
@@ -75,7 +75,7 @@ fn cloud_base_is_flat() {
         );
         let onset = (0..2000)
             .map(|k| D.band_bottom_m + k as f32)
-            .find(|&y| density_at(Vec3::new(x, y, z), &f, &D) > 0.0);
+            .find(|&y| density_at(Vec3::new(x, y, z), &f, &D, true) > 0.0);
         if let Some(y) = onset {
             onsets.push(y);
         }
@@ -189,6 +189,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
                 origin + Vec3::Y * (d.band_bottom_m + (i as f32 + 0.5) * dy),
                 &fields,
                 &d,
+                true,
             ) as f64
                 * dy as f64
         })

@@ -46,6 +46,8 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
     vec![
         ("PI", std::f32::consts::PI as f64),
         ("BASE_RAMP", density::BASE_RAMP as f64),
+        ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
+        ("DETAIL_CONTRAST", density::DETAIL_CONTRAST as f64),
         ("REFINE", renderer::REFINE as f64),
         ("ALBEDO", renderer::ALBEDO as f64),
         ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE as f64),

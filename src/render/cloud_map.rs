@@ -1,7 +1,17 @@
-//! The cloud map CM: a seeded, tileable 2D texture of cumulus cells (the
-//! cloud-map paper, section 3.2.1 and Fig. 4): Worley (Voronoi) cells
-//! multiplied with Perlin fBm for ragged edges, plus a coarser Worley
-//! channel.
+//! The cloud map CM: a seeded, tileable 2D texture of multi-scale
+//! fractal noise, the horizontal pattern the clouds take where the parcels
+//! are (the cloud-map paper's section 3.2.1 uses Worley cells times
+//! Perlin noise; one cell size made every cloud the same size).
+//!
+//! Channel 0 is Perlin fBm over `octaves` octaves from `cells` features
+//! across the map, each octave `roughness` times the last: level sets of
+//! such a field are fractal (the rougher, the higher their dimension) and
+//! its islands above a threshold have a power-law size distribution, as
+//! real cumulus fields do. Its values are replaced by their ranks, so the
+//! field is uniform on `0..1` and a threshold at `1 - f` leaves the
+//! fraction `f` of the map above it. Channel 1 is the same noise's first
+//! two octaves, ranked likewise: the large-scale pattern, whose highest
+//! points are where parcels are born.
 //!
 //! Tiling: the `noise` crate's generators are not periodic, so the map
 //! samples them in 4D on a flat torus, `(u, v) -> (R cos 2πu, R sin 2πu,
@@ -9,10 +19,7 @@
 //! construction, with no blending seam (measured in
 //! `cloud_map_tiles_seamlessly`).
 
-use noise::{
-    Fbm, MultiFractal, NoiseFn, Perlin, Worley, core::worley::ReturnType,
-    core::worley::distance_functions,
-};
+use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -24,12 +31,14 @@ pub struct CloudMapConfig {
     pub size: usize,
     /// Seed of the noise. Default 7.
     pub seed: u32,
-    /// Cumulus cells across the map (Worley frequency, 1..=64). Default 6.
+    /// Features of the largest scale across the map (1..=64). Default 4.
     pub cells: f64,
-    /// Perlin fBm features across the map (1..=256). Default 16.
-    pub detail: f64,
-    /// fBm octaves (1..=8). Default 4.
+    /// fBm octaves (1..=10). Default 4.
     pub octaves: usize,
+    /// Amplitude of each octave relative to the one before (0.3..=0.95).
+    /// Default 0.8: rough outlines (with the 3D detail noise, an
+    /// area-perimeter dimension near the 1.35 of real cloud fields).
+    pub roughness: f64,
 }
 
 impl Default for CloudMapConfig {
@@ -37,16 +46,16 @@ impl Default for CloudMapConfig {
         Self {
             size: 256,
             seed: 7,
-            cells: 6.0,
-            detail: 16.0,
+            cells: 4.0,
             octaves: 4,
+            roughness: 0.8,
         }
     }
 }
 
-/// The cloud map: `size²` texels, row-major, each `[shape, coarse]` in
-/// `0..=1`. `shape` is high in the middle of a cumulus cell and ragged at its
-/// edge; `coarse` is a Worley field with a quarter of the cells.
+/// The cloud map: `size²` texels, row-major, each `[shape, large]` in
+/// `0..1`, each uniformly distributed over the map: `shape` the
+/// multi-scale noise, `large` its two largest octaves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CloudMap {
     size: usize,
@@ -59,59 +68,48 @@ fn torus(u: f64, v: f64, features: f64) -> [f64; 4] {
     [r * a.cos(), r * a.sin(), r * b.cos(), r * b.sin()]
 }
 
+/// The rank of each value among all, mapped to `(0, 1)`: a field with a
+/// uniform histogram, so a threshold at `1 - f` leaves the fraction `f`
+/// of the map above it. Ties are broken by index (deterministic).
+fn rank_uniform(values: impl Iterator<Item = f64>) -> Vec<f64> {
+    let v: Vec<f64> = values.collect();
+    let mut order: Vec<usize> = (0..v.len()).collect();
+    order.sort_by(|&a, &b| v[a].total_cmp(&v[b]).then(a.cmp(&b)));
+    let mut out = vec![0.0; v.len()];
+    let n = v.len().max(1) as f64;
+    for (rank, &i) in order.iter().enumerate() {
+        out[i] = (rank as f64 + 0.5) / n;
+    }
+    out
+}
+
 impl CloudMap {
     /// Generates the map. Same configuration, same bytes.
     pub fn generate(cfg: &CloudMapConfig) -> Self {
         let n = cfg.size.max(1);
         // The generators are not Sync: each worker thread builds its own.
         let generators = || {
-            let worley = |seed| {
-                Worley::new(seed)
-                    .set_distance_function(distance_functions::euclidean)
-                    .set_return_type(ReturnType::Distance)
+            let fbm = |octaves: usize| {
+                Fbm::<Perlin>::new(cfg.seed.wrapping_add(2))
+                    .set_octaves(octaves.clamp(1, 10))
+                    .set_persistence(cfg.roughness)
             };
-            let fbm =
-                Fbm::<Perlin>::new(cfg.seed.wrapping_add(2)).set_octaves(cfg.octaves.clamp(1, 8));
-            (worley(cfg.seed), worley(cfg.seed.wrapping_add(1)), fbm)
+            (fbm(cfg.octaves), fbm(2))
         };
-        let raw: Vec<[f64; 3]> = (0..n * n)
+        let raw: Vec<[f64; 2]> = (0..n * n)
             .into_par_iter()
-            .map_init(generators, |(cells, coarse, fbm), k| {
+            .map_init(generators, |(fine, large), k| {
                 let (u, v) = ((k % n) as f64 / n as f64, (k / n) as f64 / n as f64);
-                [
-                    cells.get(torus(u, v, cfg.cells)),
-                    coarse.get(torus(u, v, cfg.cells * 0.5)),
-                    fbm.get(torus(u, v, cfg.detail)),
-                ]
+                let t = torus(u, v, cfg.cells);
+                [fine.get(t), large.get(t)]
             })
             .collect();
-        // Normalise each field to 0..1 over the map (deterministic: a
-        // sequential min/max).
-        let mut lo = [f64::MAX; 3];
-        let mut hi = [f64::MIN; 3];
-        for r in &raw {
-            for c in 0..3 {
-                lo[c] = lo[c].min(r[c]);
-                hi[c] = hi[c].max(r[c]);
-            }
-        }
-        let norm = |x: f64, c: usize| {
-            if hi[c] > lo[c] {
-                (x - lo[c]) / (hi[c] - lo[c])
-            } else {
-                0.0
-            }
-        };
-        let texels = raw
-            .iter()
-            .map(|r| {
-                // Near a cell's feature point the distance is 0: invert so
-                // the cell middle is 1, then sharpen the gaps between cells.
-                let cell = (1.0 - norm(r[0], 0)).powf(1.5);
-                let ragged = 0.55 + 0.45 * norm(r[2], 2);
-                let coarse = 1.0 - norm(r[1], 1);
-                [(cell * ragged) as f32, coarse as f32]
-            })
+        let a = rank_uniform(raw.iter().map(|r| r[0]));
+        let b = rank_uniform(raw.iter().map(|r| r[1]));
+        let texels = a
+            .into_iter()
+            .zip(b)
+            .map(|(a, b)| [a as f32, b as f32])
             .collect();
         Self { size: n, texels }
     }

@@ -125,7 +125,7 @@ mod tests {
         for i in 0..40_000 {
             let r = |k: i32| hash3(i, k, 7);
             let q = Vec3::new(r(1) * 10_000.0, 600.0 + r(2) * 1000.0, r(3) * 10_000.0);
-            let sigma = density_at(q, &f, &d);
+            let sigma = density_at(q, &f, &d, true);
             dense += (sigma > 0.0) as u32;
             if mask.is_empty_at(q.x / d.map_extent_m, q.z / d.map_extent_m, w, h) {
                 clear += 1;

@@ -8,4 +8,5 @@ pub mod cloud_map;
 pub mod coverage_mask;
 pub mod cpu;
 pub mod gpu;
+pub mod soft_field;
 pub mod terrain;

@@ -85,8 +85,8 @@ impl Default for RenderSettings {
             sun_azimuth_deg: 135.0,
             coverage: 0.75,
             extinction_per_m: 0.04,
-            detail_strength: 0.5,
-            detail_scale_m: 250.0,
+            detail_strength: 0.6,
+            detail_scale_m: 180.0,
             steps: 48,
             shadow_steps: 6,
             octaves: 2,
@@ -239,11 +239,11 @@ impl RenderSettings {
                 "1..=64",
             ),
             range(
-                "render.cloud_map.detail",
-                r.cloud_map.detail,
-                1.0,
-                256.0,
-                "1..=256",
+                "render.cloud_map.roughness",
+                r.cloud_map.roughness,
+                0.3,
+                0.95,
+                "0.3..=0.95",
             ),
             range(
                 "render.terrain.relief_m",
@@ -268,8 +268,8 @@ impl RenderSettings {
             ),
             Check::new(
                 "render.cloud_map.octaves",
-                (1..=8).contains(&r.cloud_map.octaves),
-                "1..=8",
+                (1..=10).contains(&r.cloud_map.octaves),
+                "1..=10",
                 r.cloud_map.octaves as f64,
             ),
         ]

@@ -74,6 +74,7 @@ pub fn run(a: StatsArgs) -> Result<()> {
         scene.name.clone()
     };
     field_stats::write(&s, &name, &a.out)?;
+    field_stats::write_optical_depth(&field, a.tau_min, &a.out)?;
     println!(
         "{}x{} columns of {:.1} m, cloudy at optical depth >= {}",
         s.width, s.height, s.cell_m, s.tau_min

@@ -109,68 +109,96 @@ pub fn value_noise3(q: Vec3, period: i32) -> f32 {
 #[inline]
 pub fn detail_noise(p: Vec3, scale_m: f32) -> f32 {
     let q = p / scale_m;
-    0.65 * value_noise3(q, 64) + 0.35 * value_noise3(q * 2.0 + Vec3::splat(17.3), 128)
+    0.5 * value_noise3(q, 64)
+        + 0.3 * value_noise3(q * 2.0 + Vec3::splat(17.3), 128)
+        + 0.2 * value_noise3(q * 4.0 + Vec3::splat(5.9), 256)
 }
 
 /// Normalised height below which the base ramps up: the base is flat
 /// because this ramp is the same everywhere.
 pub const BASE_RAMP: f32 = 0.04;
 
-/// The 2D footprint of the cloud at map coordinate `(u, v)`:
-/// `(shape, η_top, fill)`, where shape is the cloud-map cell remapped by
-/// coverage and P's coverage, `η_top` the local cloud top (taller with the
-/// parcel height `h` and in the cell's middle: rounded tops), and fill P's
-/// fill density. `(0, 0, 0)` where there is no cloud.
+/// Width of the density's ramp above the threshold, in units of the
+/// cloud field's value: how soft a cloud's surface is.
+pub const SURFACE_RAMP: f32 = 0.08;
+
+/// The 2D part of the cloud at map coordinate `(u, v)`: `(cover, top,
+/// fill, m)`. `cover` is the local cloud fraction the parcels ask for
+/// (the scene's coverage times P's spread coverage), `top` the local
+/// cloud top (normalised; from the parcels' height, taller where the
+/// map's large-scale pattern is high), `fill` P's fill, and
+/// `m` the cloud map's multi-scale value there. `(0, 0, 0, 0)` where P
+/// has no coverage.
 #[inline]
-pub fn footprint(u: f32, v: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f32) {
+pub fn footprint(u: f32, v: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f32, f32) {
     let [c, h, fill] = f.p.sample(u, v);
     if c <= 1e-3 {
-        return (0.0, 0.0, 0.0);
+        return (0.0, 0.0, 0.0, 0.0);
     }
-    let [n, coarse] = f.cloud_map.sample(u, v);
-    let cov = (d.coverage * c).clamp(0.0, 1.0);
-    let shape = ((n - (1.0 - cov)) / cov.max(1e-3)).clamp(0.0, 1.0);
-    if shape <= 0.0 {
-        return (0.0, 0.0, 0.0);
-    }
-    let top = (0.15 + 0.85 * h).clamp(0.0, 1.0) * shape.sqrt() * (0.75 + 0.25 * coarse);
-    (shape, top, fill)
+    let [m, large] = f.cloud_map.sample(u, v);
+    let cover = (d.coverage * c).clamp(0.0, 1.0);
+    let top = (0.2 + 0.8 * h).clamp(0.0, 1.0) * (0.7 + 0.3 * large);
+    (cover, top, fill, m)
 }
 
-/// Extinction coefficient σ_t (1/m) at world point `p`: zero outside the
-/// band and where P has no coverage; a flat base ramp, a dome falling to
-/// zero at the local top, scaled by P's fill density.
+/// The cumulus field's threshold at normalised height `eta` under a local
+/// top `top` where the parcels ask for a cloud fraction `cover`: the
+/// field must exceed it for cloud. Lowest just above the flat base (the
+/// widest part of a cumulus), rising as a dome `1 - (η/top)²` to 1 (no
+/// cloud) at the top, so the clouds that the field's high points make
+/// are flat-based and domed, taller where the field is higher.
 #[inline]
-pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams) -> f32 {
+pub fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
+    let t = eta / top;
+    1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0)
+}
+
+/// Spread of [`detail_noise`] about its mean 0.5 is widened by this to
+/// about a uniform variable's (its three octaves of value noise have a
+/// standard deviation near 0.11; a uniform one, 0.29).
+pub const DETAIL_CONTRAST: f32 = 2.6;
+
+/// The cloud field: the map's value `m` (uniform in 0..1) and the 3D
+/// noise `n` mixed by `s` (0: the map alone, extruded; 1: the noise
+/// alone), the noise's contrast widened and the mix's spread restored to
+/// the map's, so a threshold `1 - f` leaves about the fraction `f` cloudy
+/// whatever `s`.
+#[inline]
+pub fn cloud_field(m: f32, n: f32, s: f32) -> f32 {
+    let n = (0.5 + (n - 0.5) * DETAIL_CONTRAST).clamp(0.0, 1.0);
+    let norm = ((1.0 - s) * (1.0 - s) + s * s).sqrt().max(1e-3);
+    0.5 + ((1.0 - s) * (m - 0.5) + s * (n - 0.5)) / norm
+}
+
+/// Extinction coefficient σ_t (1/m) at world point `p`: where the cloud
+/// field (the cloud map's multi-scale value, mixed with the tileable 3D
+/// detail noise by `detail_strength`) exceeds [`cumulus_threshold`],
+/// ramping up over [`SURFACE_RAMP`], scaled by P's fill. Without the
+/// detail noise (`detail` false: shadow rays) its mean, 0.5, stands in.
+#[inline]
+pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool) -> f32 {
     let eta = height_fraction(p.y, d);
     if !(0.0..=1.0).contains(&eta) {
         return 0.0;
     }
-    let detail = d.detail_strength > 0.0;
-    // With detail, the map lookup is warped by the noise so the edges of
-    // P's parcel discs become billowed, not straight walls.
-    let (mut x, mut z, mut n) = (p.x, p.z, 0.0);
-    if detail {
-        n = detail_noise(p, d.detail_scale_m);
-        let warp = d.detail_scale_m * d.detail_strength;
-        x += (n - 0.5) * 2.0 * warp;
-        z += (value_noise3(p / d.detail_scale_m + Vec3::splat(31.1), 64) - 0.5) * 2.0 * warp;
-    }
-    let (shape, mut top, fill) = footprint(x / d.map_extent_m, z / d.map_extent_m, f, d);
-    if detail {
-        top *= 1.0 - 0.3 * d.detail_strength * n;
-    }
-    if shape <= 0.0 || eta >= top {
+    let (cover, top, fill, m) = footprint(p.x / d.map_extent_m, p.z / d.map_extent_m, f, d);
+    if cover <= 0.0 || eta >= top {
         return 0.0;
     }
-    let base = smoothstep(0.0, BASE_RAMP, eta);
-    let t = eta / top;
-    let dome = ((1.0 - t * t) * 3.0).clamp(0.0, 1.0);
-    let mut profile = base * dome * (shape * 4.0).min(1.0);
-    if detail {
-        // Erode the thin parts most (edges), the core little.
-        profile = (profile - d.detail_strength * n * (1.0 - profile)).max(0.0);
+    let threshold = cumulus_threshold(eta, top, cover);
+    let s = d.detail_strength;
+    // The highest the field can be here: skip the noise when even that
+    // stays under the threshold.
+    if cloud_field(m, 1.0, s) < threshold {
+        return 0.0;
     }
+    let n = if detail && s > 0.0 {
+        detail_noise(p, d.detail_scale_m)
+    } else {
+        0.5
+    };
+    let field = cloud_field(m, n, s);
+    let profile = ((field - threshold) / SURFACE_RAMP).clamp(0.0, 1.0);
     d.extinction_per_m * (0.3 + 0.7 * fill) * profile
 }
 

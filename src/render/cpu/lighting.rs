@@ -33,10 +33,6 @@ pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &Den
     if steps == 0 {
         return 0.0;
     }
-    let d = &DensityParams {
-        detail_strength: 0.0,
-        ..*d
-    };
     let to_top = if sun_dir.y > 1e-3 {
         (d.band_top_m - p.y).max(0.0) / sun_dir.y
     } else {
@@ -52,7 +48,7 @@ pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &Den
         if height_fraction(q.y, d) > 1.0 {
             break;
         }
-        tau += density_at(q, f, d) * dt;
+        tau += density_at(q, f, d, false) * dt;
         t += dt;
     }
     tau

@@ -115,10 +115,10 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
     // sampled REFINE times finer (the dither places the samples), so thin
     // cloud edges seen at grazing angles get several samples, and empty sky
     // costs one density lookup per interval.
-    let mut sigma_a = density_at(origin + dir * t0, &fr.fields, d);
+    let mut sigma_a = density_at(origin + dir * t0, &fr.fields, d, true);
     'march: for i in 0..steps {
         let ta = t0 + i as f32 * dt;
-        let sigma_b = density_at(origin + dir * (ta + dt), &fr.fields, d);
+        let sigma_b = density_at(origin + dir * (ta + dt), &fr.fields, d, true);
         let touched = sigma_a > 0.0 || sigma_b > 0.0;
         sigma_a = sigma_b;
         let (n, h) = if touched {
@@ -129,7 +129,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
         for j in 0..n {
             let t = ta + (j as f32 + dither) * h;
             let p = origin + dir * t;
-            let sigma_t = density_at(p, &fr.fields, d);
+            let sigma_t = density_at(p, &fr.fields, d, true);
             if sigma_t <= 0.0 {
                 continue;
             }
@@ -205,13 +205,9 @@ pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityP
     let Some((t0, t1)) = band_segment(p, sun_dir, d.band_bottom_m, d.band_top_m, 20_000.0) else {
         return 1.0;
     };
-    let d = &DensityParams {
-        detail_strength: 0.0,
-        ..*d
-    };
     let dt = (t1 - t0) / steps.max(1) as f32;
     let tau: f32 = (0..steps.max(1))
-        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d) * dt)
+        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d, false) * dt)
         .sum();
     (-tau).exp()
 }

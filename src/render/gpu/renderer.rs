@@ -36,6 +36,7 @@ use super::uniforms::{FrameInputs, FrameUniforms};
 use super::{bind, bind::Recorder};
 use crate::render::camera::{ToView, View};
 use crate::render::cloud_map::CloudMap;
+use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
 
@@ -167,10 +168,13 @@ impl CloudRenderer {
         }
     }
 
-    /// Uploads a new P (after each physics step). P may change size.
+    /// Uploads a new P (after each physics step). P may change size. The
+    /// density reads P spread to the clouds' merging scale
+    /// ([`crate::render::soft_field`]), made here from `field`.
     pub fn update_field(&mut self, queue: &wgpu::Queue, field: &ProjectedField) {
-        self.inputs
-            .update_field(&self.device, queue, field, &self.settings.density);
+        let d = &self.settings.density;
+        let soft = soft_field(field, SPREAD_M, d.map_extent_m);
+        self.inputs.update_field(&self.device, queue, &soft, d);
     }
 
     /// Adds, replaces or (with `None`) removes the terrain and its pass.

@@ -17,7 +17,7 @@ mod write;
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use write::write;
+pub use write::{write, write_optical_depth};
 
 use crate::render::cpu::density::density_at;
 use crate::render::cpu::renderer::Frame;
@@ -90,6 +90,53 @@ pub struct FieldStats {
     pub size_decades: f64,
 }
 
+/// Real cumulus fields' area-perimeter dimension (Lovejoy 1982 measured
+/// 1.35 over five decades of cloud and rain areas).
+pub const NATURAL_DIMENSION: std::ops::RangeInclusive<f64> = 1.30..=1.40;
+/// Exponents of the cloud-size density of trade and fair-weather cumulus
+/// in LES and satellite studies (e.g. Neggers et al. 2003, Zhao & Di
+/// Girolamo 2007: about -1.7 to -2.7 below the scale break).
+pub const NATURAL_SIZE_EXPONENT: std::ops::RangeInclusive<f64> = -3.0..=-1.5;
+/// The fewest decades of diameter a size fit must span to say anything.
+pub const NATURAL_MIN_DECADES: f64 = 1.0;
+
+impl FieldStats {
+    /// How the field differs from a real cumulus field seen from above,
+    /// one line per difference (empty: it looks like one by these
+    /// measures): the area-perimeter dimension in [`NATURAL_DIMENSION`],
+    /// the size density's exponent in [`NATURAL_SIZE_EXPONENT`] over at
+    /// least [`NATURAL_MIN_DECADES`] decades.
+    pub fn departures_from_nature(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        match self.dimension {
+            Some(d) if NATURAL_DIMENSION.contains(&d) => {}
+            Some(d) => out.push(format!(
+                "area-perimeter dimension {d:.3} is outside {:.2}..={:.2}",
+                NATURAL_DIMENSION.start(),
+                NATURAL_DIMENSION.end()
+            )),
+            None => out.push("too few clouds for an area-perimeter dimension".into()),
+        }
+        match self.size_fit {
+            Some(f) if NATURAL_SIZE_EXPONENT.contains(&f.slope) => {}
+            Some(f) => out.push(format!(
+                "size-density exponent {:.2} is outside {:.1}..={:.1}",
+                f.slope,
+                NATURAL_SIZE_EXPONENT.start(),
+                NATURAL_SIZE_EXPONENT.end()
+            )),
+            None => out.push("too few clouds for a size-density fit".into()),
+        }
+        if self.size_decades < NATURAL_MIN_DECADES {
+            out.push(format!(
+                "the sizes span {:.1} decades, fewer than {NATURAL_MIN_DECADES}",
+                self.size_decades
+            ));
+        }
+        out
+    }
+}
+
 /// A column field: optical depth per column and the cloudy fraction per
 /// height level.
 #[derive(Debug, Clone)]
@@ -124,7 +171,7 @@ pub fn column_field(frame: &Frame, n: usize, levels: usize) -> ColumnField {
                 );
                 for (k, c) in cloudy.iter_mut().enumerate() {
                     let y = d.band_bottom_m + (k as f32 + 0.5) * dz;
-                    let sigma = density_at(glam::Vec3::new(x, y, z), &frame.fields, d);
+                    let sigma = density_at(glam::Vec3::new(x, y, z), &frame.fields, d, true);
                     if sigma > 0.0 {
                         *t += (sigma * dz) as f64;
                         *c += 1;

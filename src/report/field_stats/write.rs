@@ -2,13 +2,37 @@
 
 use std::path::Path;
 
-use super::{Cloud, FieldStats, Fit};
-use crate::io::write_atomically;
+use super::{Cloud, ColumnField, FieldStats, Fit};
+use crate::io::{write_atomically, write_png_atomically};
 use crate::report::ReportError;
 use crate::report::plot::{Series, loglog_png};
 
 /// Clouds per m per m² in clouds per km per km².
 const PER_KM_PER_KM2: f64 = 1e9;
+
+/// Writes `optical_depth.png`: the field seen from straight above, one
+/// pixel per column, grey `1 - e^{-τ}` (black: clear sky; white: opaque),
+/// the clouds the statistics count outlined where `τ` crosses `tau_min`
+/// (red).
+pub fn write_optical_depth(f: &ColumnField, tau_min: f64, dir: &Path) -> Result<(), ReportError> {
+    let path = dir.join("optical_depth.png");
+    let (w, h) = (f.width, f.height);
+    let cloudy = |x: usize, y: usize| f.tau[(y % h) * w + (x % w)] >= tau_min;
+    let img = image::RgbImage::from_fn(w as u32, h as u32, |x, y| {
+        let (x, y) = (x as usize, y as usize);
+        let edge = cloudy(x, y)
+            && !(cloudy(x + 1, y)
+                && cloudy(x + w - 1, y)
+                && cloudy(x, y + 1)
+                && cloudy(x, y + h - 1));
+        if edge {
+            return image::Rgb([220, 40, 30]);
+        }
+        let g = (255.0 * (1.0 - (-f.tau[y * w + x]).exp())).round() as u8;
+        image::Rgb([g, g, g])
+    });
+    write_png_atomically(&path, &img).map_err(ReportError::writing(&path))
+}
 
 /// Writes `clouds.csv` (one row per cloud), `size_density.csv`,
 /// `cloud_fraction_profile.csv`, `stats.json` and the two log-log plots

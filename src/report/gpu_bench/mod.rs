@@ -154,7 +154,6 @@ pub fn scaled_scene(base: &Scene, parcels: usize) -> Scene {
     sc.physics.domain_size_m = base.physics.domain_size_m * f;
     let cm = &mut sc.render.cloud_map;
     cm.cells = (cm.cells * f).clamp(1.0, 64.0);
-    cm.detail = (cm.detail * f).clamp(1.0, 256.0);
     cm.size = ((cm.size as f64 * f) as usize).clamp(64, 2048);
     sc
 }
