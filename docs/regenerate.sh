@@ -31,7 +31,8 @@ cargo build --release --bin cumulus --example sky
 bin=target/release/cumulus
 
 echo "== gallery (README 'The two commands')"
-for s in fair_weather bomex evening strong_inversion; do
+for s in fair_weather bomex evening strong_inversion \
+  view_high_flight view_backlit view_below_base view_horizon; do
   "$bin" render --scene "scenes/$s.toml" --out "docs/$s.png"
 done
 

@@ -19,6 +19,11 @@ const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
 const SURFACE_RAMP: f32 = 0.08;
 const DETAIL_CONTRAST: f32 = 2.6;
+const WARP_SCALE_M: f32 = 9000.0;
+const WARP_AMPLITUDE: f32 = 0.17;
+const WARP_RAMP_INNER: f32 = 0.72;
+const WARP_RAMP_OUTER: f32 = 1.3;
+const WEATHER_SCALE_M: f32 = 3000.0;
 const REFINE: u32 = 4u;
 const ALBEDO: f32 = 0.99;
 const MIN_TRANSMITTANCE: f32 = 0.01;
@@ -114,12 +119,10 @@ fn detail_noise(p: vec3f, scale_m: f32) -> f32 {
         + 0.2 * value_noise3(q * 4.0 + vec3f(5.9), 256);
 }
 
-// True where the coarse max-coverage mask says no P texel near `(x, z)`
-// has coverage: the density there is zero whatever the detail warp does,
-// so the noise and the texture reads are skipped.
-fn coarse_empty(x: f32, z: f32) -> bool {
-    let u = x / frame.map.x;
-    let v = z / frame.map.x;
+// True where the coarse max-coverage mask says no P texel near map
+// coordinate `(u, v)` has coverage: the density there is zero, so the
+// texture reads are skipped.
+fn coarse_empty(u: f32, v: f32) -> bool {
     let pw = f32(frame.counts.y);
     let ph = f32(frame.counts.z);
     let cell = f32(frame.mask.z);
@@ -140,6 +143,50 @@ fn footprint(u: f32, v: f32) -> vec4f {
     let cover = clamp(frame.band.z * pf.r, 0.0, 1.0);
     let top = clamp(0.2 + 0.8 * pf.g, 0.0, 1.0) * (0.7 + 0.3 * cm.g);
     return vec4f(cover, top, pf.b, cm.r);
+}
+
+// The smooth, non-repeating displacement of the P and map lookups at
+// world (x, z), map units (the CPU's `domain_warp`).
+fn domain_warp(x: f32, z: f32) -> vec2f {
+    let a = x / WARP_SCALE_M;
+    let b = z / WARP_SCALE_M;
+    return WARP_AMPLITUDE * vec2f(
+        sin(b + 1.3) + sin((0.8 * a + 0.6 * b) * 0.91 + 4.1) + sin((0.3 * a - 0.95 * b) * 0.73 + 0.5),
+        sin(a * 1.13 + 0.7) + sin((0.6 * a - 0.8 * b) * 0.83 + 2.3) + sin((0.95 * a + 0.3 * b) * 0.67 + 5.2),
+    );
+}
+
+// The warp's weight: 0 over the simulated domain, growing to 1 with the
+// distance from its centre (the CPU's `warp_weight`).
+fn warp_weight(x: f32, z: f32) -> f32 {
+    let a = x / frame.map.x - 0.5;
+    let b = z / frame.map.x - 0.5;
+    return smoothstep(WARP_RAMP_INNER, WARP_RAMP_OUTER, sqrt(a * a + b * b));
+}
+
+// The weather modulation of the cover (the CPU's `weather`).
+fn weather(x: f32, z: f32) -> f32 {
+    let a = x / WEATHER_SCALE_M;
+    let b = z / WEATHER_SCALE_M;
+    let g = 0.5 + 0.25 * (sin(a + 0.4) * sin(b * 0.81 + 1.9) + sin((0.6 * a + 0.8 * b) * 1.37 + 2.7));
+    return 1.4 * smoothstep(0.25, 0.75, g);
+}
+
+// The footprint at world (x, z) through the domain warp, the cover
+// modulated by the weather (the CPU's `world_footprint`).
+fn world_footprint(x: f32, z: f32) -> vec4f {
+    let k = warp_weight(x, z);
+    let w = domain_warp(x, z) * k;
+    let u = x / frame.map.x + w.x;
+    let v = z / frame.map.x + w.y;
+    if coarse_empty(u, v) {
+        return vec4f(0.0);
+    }
+    let fp = footprint(u, v);
+    if fp.x <= 0.0 {
+        return vec4f(0.0);
+    }
+    return vec4f(fp.x * mix(1.0, weather(x, z), k), fp.y, fp.z, fp.w);
 }
 
 // The threshold the cloud field must exceed (the CPU's
@@ -165,10 +212,7 @@ fn density_at(p: vec3f, detail: bool) -> f32 {
     if eta < 0.0 || eta > 1.0 {
         return 0.0;
     }
-    if coarse_empty(p.x, p.z) {
-        return 0.0;
-    }
-    let fp = footprint(p.x / frame.map.x, p.z / frame.map.x);
+    let fp = world_footprint(p.x, p.z);
     if fp.x <= 0.0 || eta >= fp.y {
         return 0.0;
     }

@@ -177,9 +177,29 @@ fn constant_slab_transmittance_matches_beer_lambert() {
         extinction_per_m: 0.001,
         ..D
     };
-    // Under the middle of a cloud cell.
-    let (u, v) = cm.cell_centres(1)[0];
-    let origin = Vec3::new(u * d.map_extent_m, 0.0, v * d.map_extent_m);
+    // Under the thickest column of a coarse scan of the domain (the tiles'
+    // shifts and the weather move the clouds off the map's own cells).
+    let column_tau = |x: f32, z: f32| -> f32 {
+        (0..100)
+            .map(|k| {
+                let y = d.band_bottom_m + (k as f32 + 0.5) * 10.0;
+                density_at(Vec3::new(x, y, z), &fields, &d, true) * 10.0
+            })
+            .sum()
+    };
+    let (mut best, mut origin) = (0.0, Vec3::ZERO);
+    for j in 0..48 {
+        for i in 0..48 {
+            let (x, z) = (
+                (i as f32 + 0.5) * 10_000.0 / 48.0,
+                (j as f32 + 0.5) * 10_000.0 / 48.0,
+            );
+            let t = column_tau(x, z);
+            if t > best {
+                (best, origin) = (t, Vec3::new(x, 0.0, z));
+            }
+        }
+    }
     // Numerical optical depth along the vertical with a fine quadrature.
     let n = 200_000;
     let dy = (d.band_top_m - d.band_bottom_m) / n as f32;

@@ -18,8 +18,10 @@ pub struct StatsArgs {
     #[arg(long)]
     scene: PathBuf,
     /// Output directory (clouds.csv, size_density.csv,
-    /// cloud_fraction_profile.csv, stats.json, area_perimeter.png,
-    /// size_density.png); created if missing.
+    /// cloud_fraction_profile.csv, stats.json, repetition.json,
+    /// area_perimeter.png, size_density.png, optical_depth.png, and
+    /// repetition.png: five periods of the domain from above); created
+    /// if missing.
     #[arg(long)]
     out: PathBuf,
     /// Columns along each side of the domain (16..=2048).
@@ -66,7 +68,8 @@ pub fn run(a: StatsArgs) -> Result<()> {
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
     let r = &scene.render;
-    let field = column_field(&prepared.frame(r, r.quality()), a.resolution, a.levels);
+    let frame = prepared.frame(r, r.quality());
+    let field = column_field(&frame, a.resolution, a.levels);
     let s = field_stats::field_stats(&field, a.tau_min, a.min_cells);
     let name = if scene.name.is_empty() {
         a.scene.display().to_string()
@@ -97,6 +100,31 @@ pub fn run(a: StatsArgs) -> Result<()> {
         ),
         None => println!("size_density_exponent=none (fewer than two size bins)"),
     }
+    let off = s.departures_from_nature();
+    if off.is_empty() {
+        println!("natural=yes (D, size exponent and its span in real cumulus fields' range)");
+    } else {
+        println!("natural=no: {}", off.join("; "));
+    }
+    // Repetition: five periods of the map seen from above, centred on the
+    // simulated domain (a high flight's view over 50 km), 128 columns a
+    // period (P's resolution), 24 levels.
+    let (l, periods) = (field.cell_m * field.width as f64, 5);
+    let wide =
+        field_stats::column_field_over(&frame, -2.0 * l, periods as f64 * l, 128 * periods, 24);
+    let rep = field_stats::repetition(&wide.mask(a.tau_min), 128);
+    println!(
+        "repetition: correlation {:.3} at the map's period, at most {:.3} at other lags of its length ({})",
+        rep.period_max(),
+        rep.other_max(),
+        if rep.hidden() {
+            "not visible"
+        } else {
+            "visible"
+        }
+    );
+    field_stats::write_repetition(&rep, &a.out)?;
+    field_stats::write_optical_depth_as(&wide, a.tau_min, &a.out.join("repetition.png"))?;
     println!("wrote {}", a.out.display());
     Ok(())
 }

@@ -141,6 +141,86 @@ pub fn footprint(u: f32, v: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f3
     (cover, top, fill, m)
 }
 
+/// Length scale of the domain warp, m: its sines have wavelengths of
+/// 2π times this over 0.67-1.13 (50-85 km), in six directions, with
+/// incommensurate frequencies, so they never line up again.
+pub const WARP_SCALE_M: f32 = 9000.0;
+/// Amplitude of each of the warp's three sines per axis, in domain widths.
+/// Chosen with `cumulus stats`' repetition measure: 0.15 over 7-12 km
+/// left the period's correlation at 0.08-0.2 (rows still there), 0.17 over
+/// 9 km hides it (0.00-0.03 against 0.09-0.13 at other lags).
+pub const WARP_AMPLITUDE: f32 = 0.17;
+
+/// The displacement (map units) of the lookups into P and the cloud map
+/// at world `(x, z)`: a sum of sines of incommensurate wavelengths, smooth
+/// (it stretches the clouds by up to ~40 % locally, in directions that
+/// change across the sky) and not periodic. The
+/// simulated domain tiles the sky; without the warp the same clouds came
+/// back every domain width in rows to the horizon, and with it the copy
+/// one domain width away is looked up up to a domain width elsewhere.
+#[inline]
+pub fn domain_warp(x: f32, z: f32) -> (f32, f32) {
+    let (a, b) = (x / WARP_SCALE_M, z / WARP_SCALE_M);
+    (
+        WARP_AMPLITUDE
+            * ((b + 1.3).sin()
+                + ((0.8 * a + 0.6 * b) * 0.91 + 4.1).sin()
+                + ((0.3 * a - 0.95 * b) * 0.73 + 0.5).sin()),
+        WARP_AMPLITUDE
+            * ((a * 1.13 + 0.7).sin()
+                + ((0.6 * a - 0.8 * b) * 0.83 + 2.3).sin()
+                + ((0.95 * a + 0.3 * b) * 0.67 + 5.2).sin()),
+    )
+}
+
+/// Distances from the simulated domain's centre, in domain widths, over
+/// which the warp and the weather grow from nothing to full: the
+/// simulated copy of the domain (its corners are 0.71 from the centre) is
+/// drawn where its parcels are, as P says (the per-parcel baseline and an
+/// application's own use of the parcels agree with the picture), and the
+/// copies around it are warped. A slower ramp (to 2.0 or 2.5) left the
+/// period visible in `cumulus stats`' repetition measure.
+pub const WARP_RAMP: (f32, f32) = (0.72, 1.3);
+
+/// The weight of the [`domain_warp`] at world `(x, z)` (0 over the
+/// simulated domain, 1 from [`WARP_RAMP`]'s outer distance on).
+#[inline]
+pub fn warp_weight(x: f32, z: f32, extent_m: f32) -> f32 {
+    let (a, b) = (x / extent_m - 0.5, z / extent_m - 0.5);
+    smoothstep(WARP_RAMP.0, WARP_RAMP.1, (a * a + b * b).sqrt())
+}
+
+/// Length scale of the weather modulation, m (wavelengths of 14-25 km).
+pub const WEATHER_SCALE_M: f32 = 3000.0;
+
+/// The weather modulation at world `(x, z)`, 0..=1.4, multiplying the
+/// cover P asks for: sines of incommensurate wavelengths of 14-25 km, so
+/// over tens of kilometres the sky has banks of cloud and clear patches
+/// that do not follow the domain's tiling.
+#[inline]
+pub fn weather(x: f32, z: f32) -> f32 {
+    let (a, b) = (x / WEATHER_SCALE_M, z / WEATHER_SCALE_M);
+    let g = 0.5
+        + 0.25
+            * ((a + 0.4).sin() * (b * 0.81 + 1.9).sin() + ((0.6 * a + 0.8 * b) * 1.37 + 2.7).sin());
+    1.4 * smoothstep(0.25, 0.75, g)
+}
+
+/// [`footprint`] at world `(x, z)` through the [`domain_warp`], the cover
+/// modulated by the [`weather`] there.
+#[inline]
+pub fn world_footprint(x: f32, z: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f32, f32) {
+    let (du, dv) = domain_warp(x, z);
+    let k = warp_weight(x, z, d.map_extent_m);
+    let (du, dv) = (du * k, dv * k);
+    let (cover, top, fill, m) = footprint(x / d.map_extent_m + du, z / d.map_extent_m + dv, f, d);
+    if cover <= 0.0 {
+        return (0.0, 0.0, 0.0, 0.0);
+    }
+    // The weather, like the warp, leaves the simulated domain to P.
+    (cover * (1.0 + k * (weather(x, z) - 1.0)), top, fill, m)
+}
+
 /// The cumulus field's threshold at normalised height `eta` under a local
 /// top `top` where the parcels ask for a cloud fraction `cover`: the
 /// field must exceed it for cloud. Lowest just above the flat base (the
@@ -181,7 +261,7 @@ pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool) -> f32 {
     if !(0.0..=1.0).contains(&eta) {
         return 0.0;
     }
-    let (cover, top, fill, m) = footprint(p.x / d.map_extent_m, p.z / d.map_extent_m, f, d);
+    let (cover, top, fill, m) = world_footprint(p.x, p.z, f, d);
     if cover <= 0.0 || eta >= top {
         return 0.0;
     }

@@ -12,12 +12,14 @@
 //! joined across the periodic edges; a cloud's perimeter is its number of
 //! cell edges that face clear sky, times the cell size.
 
+mod repetition;
 mod write;
 
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use write::{write, write_optical_depth};
+pub use repetition::{Lag, Repetition, correlation, repetition};
+pub use write::{write, write_optical_depth, write_optical_depth_as, write_repetition};
 
 use crate::render::cpu::density::density_at;
 use crate::render::cpu::renderer::Frame;
@@ -154,9 +156,21 @@ pub struct ColumnField {
 /// the map (`levels` samples through the band per column, at their
 /// centres).
 pub fn column_field(frame: &Frame, n: usize, levels: usize) -> ColumnField {
+    column_field_over(frame, 0.0, frame.density.map_extent_m as f64, n, levels)
+}
+
+/// [`column_field`] over a square of `span_m` whose lower corner is at
+/// `(origin_m, origin_m)` (several periods of the map, for
+/// [`repetition`]).
+pub fn column_field_over(
+    frame: &Frame,
+    origin_m: f64,
+    span_m: f64,
+    n: usize,
+    levels: usize,
+) -> ColumnField {
     let d = &frame.density;
-    let l = d.map_extent_m as f64;
-    let cell = l / n as f64;
+    let cell = span_m / n as f64;
     let levels = levels.max(1);
     let dz = (d.band_top_m - d.band_bottom_m) / levels as f32;
     let rows: Vec<(Vec<f64>, Vec<u32>)> = (0..n)
@@ -166,8 +180,8 @@ pub fn column_field(frame: &Frame, n: usize, levels: usize) -> ColumnField {
             let mut cloudy = vec![0u32; levels];
             for (i, t) in tau.iter_mut().enumerate() {
                 let (x, z) = (
-                    ((i as f64 + 0.5) * cell) as f32,
-                    ((j as f64 + 0.5) * cell) as f32,
+                    (origin_m + (i as f64 + 0.5) * cell) as f32,
+                    (origin_m + (j as f64 + 0.5) * cell) as f32,
                 );
                 for (k, c) in cloudy.iter_mut().enumerate() {
                     let y = d.band_bottom_m + (k as f32 + 0.5) * dz;

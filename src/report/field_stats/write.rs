@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::{Cloud, ColumnField, FieldStats, Fit};
+use super::{Cloud, ColumnField, FieldStats, Fit, Repetition};
 use crate::io::{write_atomically, write_png_atomically};
 use crate::report::ReportError;
 use crate::report::plot::{Series, loglog_png};
@@ -10,12 +10,30 @@ use crate::report::plot::{Series, loglog_png};
 /// Clouds per m per m² in clouds per km per km².
 const PER_KM_PER_KM2: f64 = 1e9;
 
+/// Writes `repetition.json` ([`Repetition`]).
+pub fn write_repetition(r: &Repetition, dir: &Path) -> Result<(), ReportError> {
+    let path = dir.join("repetition.json");
+    write_atomically(&path, |out| {
+        serde_json::to_writer_pretty(&mut *out, r).map_err(std::io::Error::other)?;
+        writeln!(out)
+    })
+    .map_err(ReportError::writing(&path))
+}
+
 /// Writes `optical_depth.png`: the field seen from straight above, one
 /// pixel per column, grey `1 - e^{-τ}` (black: clear sky; white: opaque),
 /// the clouds the statistics count outlined where `τ` crosses `tau_min`
 /// (red).
 pub fn write_optical_depth(f: &ColumnField, tau_min: f64, dir: &Path) -> Result<(), ReportError> {
-    let path = dir.join("optical_depth.png");
+    write_optical_depth_as(f, tau_min, &dir.join("optical_depth.png"))
+}
+
+/// [`write_optical_depth`] into `path`.
+pub fn write_optical_depth_as(
+    f: &ColumnField,
+    tau_min: f64,
+    path: &Path,
+) -> Result<(), ReportError> {
     let (w, h) = (f.width, f.height);
     let cloudy = |x: usize, y: usize| f.tau[(y % h) * w + (x % w)] >= tau_min;
     let img = image::RgbImage::from_fn(w as u32, h as u32, |x, y| {
@@ -31,7 +49,7 @@ pub fn write_optical_depth(f: &ColumnField, tau_min: f64, dir: &Path) -> Result<
         let g = (255.0 * (1.0 - (-f.tau[y * w + x]).exp())).round() as u8;
         image::Rgb([g, g, g])
     });
-    write_png_atomically(&path, &img).map_err(ReportError::writing(&path))
+    write_png_atomically(path, &img).map_err(ReportError::writing(path))
 }
 
 /// Writes `clouds.csv` (one row per cloud), `size_density.csv`,
