@@ -1,8 +1,9 @@
 // The cloud pass: a full-screen fragment shader that ray-casts the cloud
 // height band through P (coverage, normalised height, fill) and the cloud
 // map CM. Every function here has a twin of the same name in
-// src/render/cpu/ (density.rs, lighting.rs, sky.rs, renderer.rs); the
-// parity tests render both and compare. Keep them in step.
+// src/render/cpu/ (density.rs, lighting.rs, sky.rs, renderer.rs) or
+// src/render/camera.rs; the parity tests render both and compare. Keep
+// them in step.
 //
 // The entry points are appended by src/render/gpu/shaders.rs, one per
 // variant (with or without a depth buffer, with or without the TSAA
@@ -20,7 +21,7 @@ const BASE_RAMP: f32 = 0.04;
 const SURFACE_RAMP: f32 = 0.08;
 const DETAIL_CONTRAST: f32 = 2.6;
 const WARP_SCALE_M: f32 = 9000.0;
-const WARP_AMPLITUDE: f32 = 0.17;
+const WARP_AMPLITUDE_M: f32 = 1700.0;
 const WARP_RAMP_INNER: f32 = 0.72;
 const WARP_RAMP_OUTER: f32 = 1.3;
 const WEATHER_SCALE_M: f32 = 3000.0;
@@ -150,7 +151,7 @@ fn footprint(u: f32, v: f32) -> vec4f {
 fn domain_warp(x: f32, z: f32) -> vec2f {
     let a = x / WARP_SCALE_M;
     let b = z / WARP_SCALE_M;
-    return WARP_AMPLITUDE * vec2f(
+    return WARP_AMPLITUDE_M / frame.map.x * vec2f(
         sin(b + 1.3) + sin((0.8 * a + 0.6 * b) * 0.91 + 4.1) + sin((0.3 * a - 0.95 * b) * 0.73 + 0.5),
         sin(a * 1.13 + 0.7) + sin((0.6 * a - 0.8 * b) * 0.83 + 2.3) + sin((0.95 * a + 0.3 * b) * 0.67 + 5.2),
     );
@@ -336,8 +337,8 @@ fn tone_map(c: f32, exposure: f32) -> f32 {
     return 1.0 - exp(-max(c, 0.0) * exposure);
 }
 
-// The ray through pixel coordinate `px` (0.5 = a pixel's centre).
-// Normalised device coordinates of a pixel position (y up).
+// Normalised device coordinates of a pixel position (y up; 0.5 = a
+// pixel's centre).
 fn pixel_ndc(px: vec2f) -> vec2f {
     return vec2f(2.0 * px.x / frame.screen.x - 1.0, 1.0 - 2.0 * px.y / frame.screen.y);
 }

@@ -49,7 +49,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
         ("DETAIL_CONTRAST", density::DETAIL_CONTRAST as f64),
         ("WARP_SCALE_M", density::WARP_SCALE_M as f64),
-        ("WARP_AMPLITUDE", density::WARP_AMPLITUDE as f64),
+        ("WARP_AMPLITUDE_M", density::WARP_AMPLITUDE_M as f64),
         ("WARP_RAMP_INNER", density::WARP_RAMP.0 as f64),
         ("WARP_RAMP_OUTER", density::WARP_RAMP.1 as f64),
         ("WEATHER_SCALE_M", density::WEATHER_SCALE_M as f64),

@@ -111,7 +111,7 @@ pub enum CameraError {
     )]
     NotPerspective,
     #[error(
-        "the view matrix scales or shears (its rotation part must be orthonormal, distances are in metres)"
+        "the view matrix is not a rigid motion (its rotation part must be orthonormal and its bottom row 0 0 0 1; distances are in metres)"
     )]
     NotRigid,
 }
@@ -144,7 +144,9 @@ impl View {
         }
         let r = glam::Mat3::from_mat4(world_to_view);
         let gram = r.transpose() * r;
-        if !gram.abs_diff_eq(glam::Mat3::IDENTITY, 1e-3) {
+        let bottom = world_to_view.row(3);
+        if !gram.abs_diff_eq(glam::Mat3::IDENTITY, 1e-3) || !bottom.abs_diff_eq(glam::Vec4::W, 1e-6)
+        {
             return Err(CameraError::NotRigid);
         }
         // The eye maps to w = 0 and a point in front of it to w > 0.

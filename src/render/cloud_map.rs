@@ -9,9 +9,10 @@
 //! its islands above a threshold have a power-law size distribution, as
 //! real cumulus fields do. Its values are replaced by their ranks, so the
 //! field is uniform on `0..1` and a threshold at `1 - f` leaves the
-//! fraction `f` of the map above it. Channel 1 is the same noise's first
-//! two octaves, ranked likewise: the large-scale pattern, whose highest
-//! points are where parcels are born.
+//! fraction `f` of the map above it. Parcels are born at channel 0's
+//! highest local maxima. Channel 1 is the same noise's first two octaves,
+//! ranked likewise: the large-scale pattern, which raises the local cloud
+//! top.
 //!
 //! Tiling: the `noise` crate's generators are not periodic, so the map
 //! samples them in 4D on a flat torus, `(u, v) -> (R cos 2πu, R sin 2πu,

@@ -1,9 +1,10 @@
 //! The coarse max-coverage mask of P: one cell per `cell x cell` texels of
 //! P, set where any texel within the cell, grown by a dilation, has
 //! coverage. Where a cell is clear, the density is zero for every point
-//! whose map lookup can land there (bilinear filtering reaches one texel,
-//! the detail warp `detail_scale_m * detail_strength` further), so the GPU
-//! march skips the detail noise and the texture reads there. It is only an
+//! whose lookup into P lands there (bilinear filtering reaches one texel;
+//! an optional `warp_m` dilates further, for a lookup displaced after the
+//! mask is read), so the GPU march skips the detail noise and the texture
+//! reads there. It is only an
 //! early exit: the image is the same with or without it (tested against
 //! the CPU `density_at`).
 
@@ -118,7 +119,7 @@ mod tests {
             detail_strength: 0.8,
             detail_scale_m: 400.0,
         };
-        let mask = CoverageMask::build(&p, d.map_extent_m, d.detail_scale_m * d.detail_strength);
+        let mask = CoverageMask::build(&p, d.map_extent_m, 0.0);
         let f = Fields {
             p: &p,
             cloud_map: &cm,
@@ -130,7 +131,7 @@ mod tests {
             let sigma = density_at(q, &f, &d, true);
             dense += (sigma > 0.0) as u32;
             // The density looks P up through the domain warp.
-            let (du, dv) = domain_warp(q.x, q.z);
+            let (du, dv) = domain_warp(q.x, q.z, d.map_extent_m);
             let k = warp_weight(q.x, q.z, d.map_extent_m);
             let (u, v) = (q.x / d.map_extent_m + k * du, q.z / d.map_extent_m + k * dv);
             if mask.is_empty_at(u, v, w, h) {

@@ -31,7 +31,7 @@ pub const SPREAD_M: f32 = 400.0;
 /// returns `p` unchanged.
 pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedField {
     let (w, h) = (p.width(), p.height());
-    if sigma_m <= 0.0 || w == 0 || h == 0 {
+    if !(sigma_m > 0.0 && extent_m.is_finite() && extent_m > 0.0) || w == 0 || h == 0 {
         return p.clone();
     }
     // Weighted channels: coverage, coverage·height, coverage·fill.
@@ -40,17 +40,20 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
         .iter()
         .map(|t| [t[0], t[0] * t[1], t[0] * t[2]])
         .collect();
-    let kernel = |texel_m: f32| -> Vec<f32> {
+    // Three standard deviations, but never wider than the field itself
+    // (a kernel wider than a period is nearly flat there anyway), so the
+    // cost stays within texels x width.
+    let kernel = |texel_m: f32, n: usize| -> Vec<f32> {
         let s = (sigma_m / texel_m).max(1e-3);
-        let r = (3.0 * s).ceil() as i64;
+        let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
         let k: Vec<f32> = (-r..=r)
             .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
             .collect();
         let sum: f32 = k.iter().sum();
         k.into_iter().map(|x| x / sum).collect()
     };
-    let kx = kernel(extent_m / w as f32);
-    let ky = kernel(extent_m / h as f32);
+    let kx = kernel(extent_m / w as f32, w);
+    let ky = kernel(extent_m / h as f32, h);
     let mut b = vec![[0.0_f32; 3]; w * h];
     let rx = (kx.len() / 2) as i64;
     for y in 0..h {

@@ -108,7 +108,7 @@ pub fn run(a: StatsArgs) -> Result<()> {
     }
     // Repetition: five periods of the map seen from above, centred on the
     // simulated domain (a high flight's view over 50 km), 128 columns a
-    // period (P's resolution), 24 levels.
+    // period (78 m over the shipped 10 km domains), 24 levels.
     let (l, periods) = (field.cell_m * field.width as f64, 5);
     let wide =
         field_stats::column_field_over(&frame, -2.0 * l, periods as f64 * l, 128 * periods, 24);

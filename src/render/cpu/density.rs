@@ -104,7 +104,7 @@ pub fn value_noise3(q: Vec3, period: i32) -> f32 {
     lerp(lerp(x00, x10, w.y), lerp(x01, x11, w.y), w.z)
 }
 
-/// Two octaves of [`value_noise3`] at world point `p` with features of
+/// Three octaves of [`value_noise3`] at world point `p` with features of
 /// `scale_m`; tileable every 64 features.
 #[inline]
 pub fn detail_noise(p: Vec3, scale_m: f32) -> f32 {
@@ -145,28 +145,31 @@ pub fn footprint(u: f32, v: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f3
 /// 2π times this over 0.67-1.13 (50-85 km), in six directions, with
 /// incommensurate frequencies, so they never line up again.
 pub const WARP_SCALE_M: f32 = 9000.0;
-/// Amplitude of each of the warp's three sines per axis, in domain widths.
-/// Chosen with `cumulus stats`' repetition measure: 0.15 over 7-12 km
-/// left the period's correlation at 0.08-0.2 (rows still there), 0.17 over
-/// 9 km hides it (0.00-0.03 against 0.09-0.13 at other lags).
-pub const WARP_AMPLITUDE: f32 = 0.17;
+/// Amplitude of each of the warp's three sines per axis, m (in metres, not
+/// domain widths, so the warp's stretch stays under ~40 % whatever the
+/// domain's size). Chosen with `cumulus stats`' repetition measure on the
+/// 10 km domains: 1,500 m over 7-12 km left the period's correlation at
+/// 0.08-0.2 (rows still there); 1,700 m over 9 km hides it (0.024 and
+/// 0.032 against 0.045-0.049 at other lags).
+pub const WARP_AMPLITUDE_M: f32 = 1700.0;
 
-/// The displacement (map units) of the lookups into P and the cloud map
-/// at world `(x, z)`: a sum of sines of incommensurate wavelengths, smooth
+/// The displacement (map units, for a map of `extent_m`) of the lookups
+/// into P and the cloud map at world `(x, z)`: a sum of sines of incommensurate wavelengths, smooth
 /// (it stretches the clouds by up to ~40 % locally, in directions that
 /// change across the sky) and not periodic. The
 /// simulated domain tiles the sky; without the warp the same clouds came
 /// back every domain width in rows to the horizon, and with it the copy
 /// one domain width away is looked up up to a domain width elsewhere.
 #[inline]
-pub fn domain_warp(x: f32, z: f32) -> (f32, f32) {
+pub fn domain_warp(x: f32, z: f32, extent_m: f32) -> (f32, f32) {
     let (a, b) = (x / WARP_SCALE_M, z / WARP_SCALE_M);
+    let amplitude = WARP_AMPLITUDE_M / extent_m;
     (
-        WARP_AMPLITUDE
+        amplitude
             * ((b + 1.3).sin()
                 + ((0.8 * a + 0.6 * b) * 0.91 + 4.1).sin()
                 + ((0.3 * a - 0.95 * b) * 0.73 + 0.5).sin()),
-        WARP_AMPLITUDE
+        amplitude
             * ((a * 1.13 + 0.7).sin()
                 + ((0.6 * a - 0.8 * b) * 0.83 + 2.3).sin()
                 + ((0.95 * a + 0.3 * b) * 0.67 + 5.2).sin()),
@@ -210,7 +213,7 @@ pub fn weather(x: f32, z: f32) -> f32 {
 /// modulated by the [`weather`] there.
 #[inline]
 pub fn world_footprint(x: f32, z: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f32, f32) {
-    let (du, dv) = domain_warp(x, z);
+    let (du, dv) = domain_warp(x, z, d.map_extent_m);
     let k = warp_weight(x, z, d.map_extent_m);
     let (du, dv) = (du * k, dv * k);
     let (cover, top, fill, m) = footprint(x / d.map_extent_m + du, z / d.map_extent_m + dv, f, d);

@@ -4,7 +4,8 @@
 //!
 //! World frame: `x` east, `y` up, `z` north, metres. The physics domain's
 //! `(x, y)` maps to the world's `(x, z)`; P and the cloud map both span
-//! `map_extent_m` and repeat to the horizon.
+//! `map_extent_m` and repeat to the horizon, looked up through a
+//! non-periodic warp outside the simulated domain (`density::domain_warp`).
 
 pub mod density;
 pub mod lighting;

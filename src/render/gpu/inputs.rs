@@ -152,12 +152,9 @@ impl Inputs {
         let Some(field) = &self.field else {
             return false;
         };
-        let warp = if d.detail_strength > 0.0 {
-            d.detail_scale_m * d.detail_strength
-        } else {
-            0.0
-        };
-        let mask = CoverageMask::build(field, d.map_extent_m, warp);
+        // The lookups are where P is read (after the domain warp): only
+        // the bilinear reach dilates the mask.
+        let mask = CoverageMask::build(field, d.map_extent_m, 0.0);
         let info = [mask.width as u32, mask.height as u32, mask.cell as u32, 0];
         if info == self.mask_info {
             textures::write_all(queue, &self.mask, &mask.cells, 1);

@@ -19,8 +19,8 @@ pub struct Lag {
 pub struct Repetition {
     /// Shifts by one period along x and along z.
     pub at_period: Vec<Lag>,
-    /// Shifts of the same length at 15° to 75° (every 15°) and the
-    /// diagonals.
+    /// Shifts of the same length in ten other directions: 15° to 165°
+    /// every 15°, leaving out 90° (the other period).
     pub other: Vec<Lag>,
 }
 
