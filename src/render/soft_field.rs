@@ -35,7 +35,7 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
         return p.clone();
     }
     // Weighted channels: coverage, coverage·height, coverage·fill.
-    let mut a: Vec<[f32; 3]> = p
+    let a: Vec<[f32; 3]> = p
         .texels()
         .iter()
         .map(|t| [t[0], t[0] * t[1], t[0] * t[2]])
@@ -54,35 +54,8 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
     };
     let kx = kernel(extent_m / w as f32, w);
     let ky = kernel(extent_m / h as f32, h);
-    let mut b = vec![[0.0_f32; 3]; w * h];
-    let rx = (kx.len() / 2) as i64;
-    for y in 0..h {
-        for x in 0..w {
-            let mut s = [0.0_f32; 3];
-            for (j, kv) in kx.iter().enumerate() {
-                let xx = (x as i64 + j as i64 - rx).rem_euclid(w as i64) as usize;
-                let t = a[y * w + xx];
-                for c in 0..3 {
-                    s[c] += kv * t[c];
-                }
-            }
-            b[y * w + x] = s;
-        }
-    }
-    let ry = (ky.len() / 2) as i64;
-    for y in 0..h {
-        for x in 0..w {
-            let mut s = [0.0_f32; 3];
-            for (j, kv) in ky.iter().enumerate() {
-                let yy = (y as i64 + j as i64 - ry).rem_euclid(h as i64) as usize;
-                let t = b[yy * w + x];
-                for c in 0..3 {
-                    s[c] += kv * t[c];
-                }
-            }
-            a[y * w + x] = s;
-        }
-    }
+    let b = blur_axis(&a, w, h, &kx, true);
+    let a = blur_axis(&b, w, h, &ky, false);
     let texels = a
         .into_iter()
         .map(|[c, ch, cf]| {
@@ -98,6 +71,31 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
         })
         .collect();
     ProjectedField::from_texels(w, h, texels).unwrap_or_else(|| p.clone())
+}
+
+/// `src` (`w x h`, row-major) convolved with the centred kernel `k` along
+/// rows (`along_x`) or columns, periodically.
+fn blur_axis(src: &[[f32; 3]], w: usize, h: usize, k: &[f32], along_x: bool) -> Vec<[f32; 3]> {
+    let r = (k.len() / 2) as i64;
+    let mut out = vec![[0.0_f32; 3]; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let mut s = [0.0_f32; 3];
+            for (j, kv) in k.iter().enumerate() {
+                let o = j as i64 - r;
+                let t = if along_x {
+                    src[y * w + (x as i64 + o).rem_euclid(w as i64) as usize]
+                } else {
+                    src[(y as i64 + o).rem_euclid(h as i64) as usize * w + x]
+                };
+                for c in 0..3 {
+                    s[c] += kv * t[c];
+                }
+            }
+            out[y * w + x] = s;
+        }
+    }
+    out
 }
 
 #[cfg(test)]

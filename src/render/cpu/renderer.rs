@@ -219,17 +219,29 @@ pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityP
 /// surfaces at 48 steps) averages out, as the GPU's TSAA averages its
 /// per-frame offsets. `offsets = 1` is [`render_linear`].
 pub fn render_linear_offsets(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec3> {
+    render_marches(width, height, fr, offsets, |s| s.radiance.extend(0.0))
+        .into_iter()
+        .map(Vec4::truncate)
+        .collect()
+}
+
+/// Per pixel (rayon over rows, row-major) the mean over `offsets` shifted
+/// marches of `pick` of the ray's sample.
+fn render_marches(
+    width: u32,
+    height: u32,
+    fr: &Frame,
+    offsets: u32,
+    pick: impl Fn(RaySample) -> Vec4 + Sync,
+) -> Vec<Vec4> {
     let n = offsets.max(1);
     let w = width as usize;
-    let mut out = vec![Vec3::ZERO; w * height as usize];
+    let mut out = vec![Vec4::ZERO; w * height as usize];
     out.par_chunks_mut(w.max(1))
         .enumerate()
         .for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
-                *px = mean_march(x as u32, y as u32, width, height, fr, n, |s| {
-                    s.radiance.extend(0.0)
-                })
-                .truncate();
+                *px = mean_march(x as u32, y as u32, width, height, fr, n, &pick);
             }
         });
     out
@@ -243,7 +255,7 @@ fn mean_march(
     height: u32,
     fr: &Frame,
     n: u32,
-    pick: impl Fn(RaySample) -> Vec4,
+    pick: &impl Fn(RaySample) -> Vec4,
 ) -> Vec4 {
     let dir = fr
         .view
@@ -269,19 +281,9 @@ pub fn render_clouds_linear(width: u32, height: u32, fr: &Frame, offsets: u32) -
         terrain: None,
         ..*fr
     };
-    let n = offsets.max(1);
-    let w = width as usize;
-    let mut out = vec![Vec4::ZERO; w * height as usize];
-    out.par_chunks_mut(w.max(1))
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, px) in row.iter_mut().enumerate() {
-                *px = mean_march(x as u32, y as u32, width, height, fr, n, |s| {
-                    s.clouds.extend(1.0 - s.transmittance)
-                });
-            }
-        });
-    out
+    render_marches(width, height, fr, offsets, |s| {
+        s.clouds.extend(1.0 - s.transmittance)
+    })
 }
 
 /// Renders a `width x height` image of linear radiance, row-major, each
