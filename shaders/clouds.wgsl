@@ -173,13 +173,21 @@ fn weather(x: f32, z: f32) -> f32 {
     return 1.4 * smoothstep(0.25, 0.75, g);
 }
 
+// Where world (x, z) reads P and the map: (u, v) through the weighted
+// domain warp, and the weight (the CPU's `warped_lookup`).
+fn warped_lookup(x: f32, z: f32) -> vec3f {
+    let k = warp_weight(x, z);
+    let w = domain_warp(x, z) * k;
+    return vec3f(x / frame.map.x + w.x, z / frame.map.x + w.y, k);
+}
+
 // The footprint at world (x, z) through the domain warp, the cover
 // modulated by the weather (the CPU's `world_footprint`).
 fn world_footprint(x: f32, z: f32) -> vec4f {
-    let k = warp_weight(x, z);
-    let w = domain_warp(x, z) * k;
-    let u = x / frame.map.x + w.x;
-    let v = z / frame.map.x + w.y;
+    let l = warped_lookup(x, z);
+    let u = l.x;
+    let v = l.y;
+    let k = l.z;
     if coarse_empty(u, v) {
         return vec4f(0.0);
     }

@@ -10,12 +10,7 @@ use cumulus::report::field_stats::{Cloud, Mask, area_perimeter_fit, size_density
 const D_TOLERANCE: f64 = 0.05;
 
 fn blank(w: usize, h: usize) -> Mask {
-    Mask {
-        width: w,
-        height: h,
-        cell_m: 10.0,
-        cells: vec![false; w * h],
-    }
+    Mask::from_fn(w, h, 10.0, |_, _| false)
 }
 
 #[test]

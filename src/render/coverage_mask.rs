@@ -1,10 +1,9 @@
 //! The coarse max-coverage mask of P: one cell per `cell x cell` texels of
 //! P, set where any texel within the cell, grown by a dilation, has
 //! coverage. Where a cell is clear, the density is zero for every point
-//! whose lookup into P lands there (bilinear filtering reaches one texel;
-//! an optional `warp_m` dilates further, for a lookup displaced after the
-//! mask is read), so the GPU march skips the detail noise and the texture
-//! reads there. It is only an
+//! whose lookup into P lands there (bilinear filtering reaches one texel),
+//! so the GPU march skips the detail noise and the texture reads there.
+//! It is only an
 //! early exit: the image is the same with or without it (tested against
 //! the CPU `density_at`).
 
@@ -27,13 +26,12 @@ pub struct CoverageMask {
 }
 
 impl CoverageMask {
-    /// Builds the mask of `p` for a map extent of `map_extent_m` and a
-    /// detail warp of at most `warp_m`.
-    pub fn build(p: &ProjectedField, map_extent_m: f32, warp_m: f32) -> Self {
+    /// Builds the mask of `p`.
+    pub fn build(p: &ProjectedField) -> Self {
         let (pw, ph) = (p.width().max(1), p.height().max(1));
         let (w, h) = (pw.div_ceil(CELL), ph.div_ceil(CELL));
-        let reach = |n: usize| 1 + (warp_m.max(0.0) / (map_extent_m / n as f32)).ceil() as i64;
-        let (rx, ry) = (reach(pw).min(pw as i64), reach(ph).min(ph as i64));
+        // Bilinear filtering reaches one texel.
+        let (rx, ry) = (1.min(pw as i64), 1.min(ph as i64));
         // Covered texels, dilated by (rx, ry) with wrap-around: first along
         // x, then along y (separable max).
         let covered: Vec<bool> = (0..pw * ph)
@@ -84,9 +82,7 @@ impl CoverageMask {
 mod tests {
     use super::*;
     use crate::render::cloud_map::{CloudMap, CloudMapConfig};
-    use crate::render::cpu::density::{
-        DensityParams, Fields, density_at, domain_warp, hash3, warp_weight,
-    };
+    use crate::render::cpu::density::{DensityParams, Fields, density_at, hash3, warped_lookup};
     use glam::Vec3;
 
     /// Wherever the mask is clear, the CPU density is zero: the GPU's early
@@ -119,7 +115,7 @@ mod tests {
             detail_strength: 0.8,
             detail_scale_m: 400.0,
         };
-        let mask = CoverageMask::build(&p, d.map_extent_m, 0.0);
+        let mask = CoverageMask::build(&p);
         let f = Fields {
             p: &p,
             cloud_map: &cm,
@@ -131,9 +127,7 @@ mod tests {
             let sigma = density_at(q, &f, &d, true);
             dense += (sigma > 0.0) as u32;
             // The density looks P up through the domain warp.
-            let (du, dv) = domain_warp(q.x, q.z, d.map_extent_m);
-            let k = warp_weight(q.x, q.z, d.map_extent_m);
-            let (u, v) = (q.x / d.map_extent_m + k * du, q.z / d.map_extent_m + k * dv);
+            let (u, v, _) = warped_lookup(q.x, q.z, d.map_extent_m);
             if mask.is_empty_at(u, v, w, h) {
                 clear += 1;
                 assert_eq!(sigma, 0.0, "density {sigma} in a clear cell at {q}");

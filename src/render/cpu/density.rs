@@ -209,14 +209,21 @@ pub fn weather(x: f32, z: f32) -> f32 {
     1.4 * smoothstep(0.25, 0.75, g)
 }
 
+/// Where world `(x, z)` reads P and the cloud map: map coordinates through
+/// the [`domain_warp`] at its [`warp_weight`], and that weight.
+#[inline]
+pub fn warped_lookup(x: f32, z: f32, extent_m: f32) -> (f32, f32, f32) {
+    let (du, dv) = domain_warp(x, z, extent_m);
+    let k = warp_weight(x, z, extent_m);
+    (x / extent_m + k * du, z / extent_m + k * dv, k)
+}
+
 /// [`footprint`] at world `(x, z)` through the [`domain_warp`], the cover
 /// modulated by the [`weather`] there.
 #[inline]
 pub fn world_footprint(x: f32, z: f32, f: &Fields, d: &DensityParams) -> (f32, f32, f32, f32) {
-    let (du, dv) = domain_warp(x, z, d.map_extent_m);
-    let k = warp_weight(x, z, d.map_extent_m);
-    let (du, dv) = (du * k, dv * k);
-    let (cover, top, fill, m) = footprint(x / d.map_extent_m + du, z / d.map_extent_m + dv, f, d);
+    let (u, v, k) = warped_lookup(x, z, d.map_extent_m);
+    let (cover, top, fill, m) = footprint(u, v, f, d);
     if cover <= 0.0 {
         return (0.0, 0.0, 0.0, 0.0);
     }

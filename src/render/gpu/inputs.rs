@@ -5,7 +5,6 @@ use super::bind::{self, FILTERABLE};
 use super::textures;
 use crate::render::cloud_map::CloudMap;
 use crate::render::coverage_mask::CoverageMask;
-use crate::render::cpu::density::DensityParams;
 use crate::sim::ProjectedField;
 
 /// Group 0 and the textures behind it.
@@ -21,19 +20,11 @@ pub struct Inputs {
     mask: wgpu::Texture,
     /// The coverage mask: width, height, P texels per cell, 0.
     pub mask_info: [u32; 4],
-    /// The last P uploaded (the mask is rebuilt from it when the density
-    /// changes).
-    field: Option<ProjectedField>,
 }
 
 impl Inputs {
     /// The inputs with `cloud_map` uploaded and an empty P (clear sky).
-    pub fn new(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        cloud_map: &CloudMap,
-        density: &DensityParams,
-    ) -> Self {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, cloud_map: &CloudMap) -> Self {
         let uniforms = bind::uniform_buffer(device, "clouds.frame_uniforms");
         let layout = bind::layout(
             device,
@@ -64,7 +55,7 @@ impl Inputs {
             &textures::field_texels(&empty),
         );
         let cloud_map = upload_cloud_map(device, queue, cloud_map);
-        let mask = CoverageMask::build(&empty, density.map_extent_m, 0.0);
+        let mask = CoverageMask::build(&empty);
         let mask_texture = textures::upload_mask(device, queue, &mask);
         let group = group0(
             device,
@@ -85,7 +76,6 @@ impl Inputs {
             cloud_map,
             mask: mask_texture,
             mask_info: [1, 1, mask.cell as u32, 0],
-            field: None,
         }
     }
 
@@ -95,7 +85,6 @@ impl Inputs {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         field: &ProjectedField,
-        density: &DensityParams,
     ) {
         let (w, h) = (field.width().max(1) as u32, field.height().max(1) as u32);
         let texels = if field.width() == 0 || field.height() == 0 {
@@ -111,22 +100,8 @@ impl Inputs {
         } else {
             textures::write_all(queue, &self.p_texture, bytemuck::cast_slice(&texels), 8);
         }
-        self.field = Some(field.clone());
-        rebind |= self.upload_mask(device, queue, density);
+        rebind |= self.upload_mask(device, queue, field);
         if rebind {
-            self.rebind(device);
-        }
-    }
-
-    /// Rebuilds the coverage mask for the last P and `density` (its detail
-    /// warp widens the mask).
-    pub fn update_mask(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        density: &DensityParams,
-    ) {
-        if self.upload_mask(device, queue, density) {
             self.rebind(device);
         }
     }
@@ -142,19 +117,15 @@ impl Inputs {
         self.rebind(device);
     }
 
-    /// Writes the mask; whether its texture was replaced (new size).
+    /// Writes the mask of `field`; whether its texture was replaced (new
+    /// size).
     fn upload_mask(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        d: &DensityParams,
+        field: &ProjectedField,
     ) -> bool {
-        let Some(field) = &self.field else {
-            return false;
-        };
-        // The lookups are where P is read (after the domain warp): only
-        // the bilinear reach dilates the mask.
-        let mask = CoverageMask::build(field, d.map_extent_m, 0.0);
+        let mask = CoverageMask::build(field);
         let info = [mask.width as u32, mask.height as u32, mask.cell as u32, 0];
         if info == self.mask_info {
             textures::write_all(queue, &self.mask, &mask.cells, 1);

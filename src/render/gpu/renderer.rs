@@ -125,6 +125,9 @@ pub struct CloudRenderer {
     composite: CompositePass,
     prev_view: Option<View>,
     prev_view_proj: Mat4,
+    /// The last P given to [`Self::update_field`], as projected (spread
+    /// again when the map extent changes).
+    field: Option<ProjectedField>,
     frame_index: u32,
     timestamps: Option<wgpu::QuerySet>,
     last_passes: Vec<&'static str>,
@@ -142,7 +145,7 @@ impl CloudRenderer {
         cloud_map: &CloudMap,
         terrain: Option<&Heightfield>,
     ) -> Self {
-        let inputs = Inputs::new(device, queue, cloud_map, &settings.density);
+        let inputs = Inputs::new(device, queue, cloud_map);
         let constants = settings.constants();
         let size = (0, 0);
         Self {
@@ -161,6 +164,7 @@ impl CloudRenderer {
             width: size.0,
             height: size.1,
             prev_view: None,
+            field: None,
             prev_view_proj: Mat4::IDENTITY,
             frame_index: 0,
             timestamps: None,
@@ -172,9 +176,9 @@ impl CloudRenderer {
     /// density reads P spread to the clouds' merging scale
     /// ([`crate::render::soft_field`]), made here from `field`.
     pub fn update_field(&mut self, queue: &wgpu::Queue, field: &ProjectedField) {
-        let d = &self.settings.density;
-        let soft = soft_field(field, SPREAD_M, d.map_extent_m);
-        self.inputs.update_field(&self.device, queue, &soft, d);
+        let soft = soft_field(field, SPREAD_M, self.settings.density.map_extent_m);
+        self.inputs.update_field(&self.device, queue, &soft);
+        self.field = Some(field.clone());
     }
 
     /// Adds, replaces or (with `None`) removes the terrain and its pass.
@@ -221,9 +225,12 @@ impl CloudRenderer {
         if constants_changed && let Some(t) = &mut self.terrain {
             t.rebuild_pipeline(&self.device, &self.inputs.layout, &constants);
         }
-        if old.density != settings.density {
-            self.inputs
-                .update_mask(&self.device, &self.queue, &settings.density);
+        // The spread is in metres: a new map extent spreads P anew.
+        if old.density.map_extent_m != settings.density.map_extent_m
+            && let Some(f) = self.field.take()
+        {
+            let queue = self.queue.clone();
+            self.update_field(&queue, &f);
         }
     }
 

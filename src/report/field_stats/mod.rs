@@ -233,6 +233,24 @@ impl ColumnField {
 }
 
 impl Mask {
+    /// A `width x height` mask of cells of `cell_m`, cloudy where
+    /// `cloudy(x, y)`.
+    pub fn from_fn(
+        width: usize,
+        height: usize,
+        cell_m: f64,
+        cloudy: impl Fn(usize, usize) -> bool,
+    ) -> Self {
+        Self {
+            width,
+            height,
+            cell_m,
+            cells: (0..width * height)
+                .map(|k| cloudy(k % width, k / width))
+                .collect(),
+        }
+    }
+
     /// The clouds: 4-connected cloudy regions, joined across the periodic
     /// edges, with area and perimeter.
     pub fn clouds(&self) -> Vec<Cloud> {
@@ -431,12 +449,7 @@ mod tests {
     use super::*;
 
     fn mask(w: usize, h: usize, f: impl Fn(usize, usize) -> bool) -> Mask {
-        Mask {
-            width: w,
-            height: h,
-            cell_m: 1.0,
-            cells: (0..w * h).map(|i| f(i % w, i / w)).collect(),
-        }
+        Mask::from_fn(w, h, 1.0, f)
     }
 
     #[test]

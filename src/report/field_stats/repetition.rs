@@ -105,12 +105,7 @@ mod tests {
     use super::*;
 
     fn mask(w: usize, h: usize, f: impl Fn(usize, usize) -> bool) -> Mask {
-        Mask {
-            width: w,
-            height: h,
-            cell_m: 1.0,
-            cells: (0..w * h).map(|k| f(k % w, k / w)).collect(),
-        }
+        Mask::from_fn(w, h, 1.0, f)
     }
 
     /// A tiled pattern repeats at its period and nowhere else; a pattern
