@@ -240,7 +240,7 @@ fn sample(_z: f64, p_pa: f64, t_k: f64, q_total: f64) -> EnvSample {
         qv,
         qc,
         theta_v: virtual_potential_temperature(theta, qv, qc),
-        theta_l: liquid_water_potential_temperature(theta, qc, ex),
+        theta_l: liquid_water_potential_temperature(t_k, p_pa, q_total, qc),
         qt: q_total,
     }
 }

@@ -9,7 +9,7 @@ use super::config::PhysicsConfig;
 use super::constants::R_D;
 use super::lift::surface_lcl_height;
 use super::parcels::{Life, Parcels, keyed_uniform};
-use super::thermo::saturation_mixing_ratio;
+use super::thermo::{saturation_mixing_ratio, unsaturated_temperature};
 use super::update::{diagnose, wind_at};
 
 pub(super) fn air_mass(env: &EnvSample, radius_m: f64) -> f64 {
@@ -28,8 +28,14 @@ pub(super) fn release_qt_cap(cfg: &PhysicsConfig, atm: &Atmosphere) -> f64 {
     let theta_l = atm.at(z0).theta_l + cfg.initial_excess_k;
     let base = surface_lcl_height(atm).unwrap_or(atm.top_m()).max(z0);
     let e = atm.at(base);
-    // Unsaturated below the base: θ = θ_l, so T = θ_l Π.
-    saturation_mixing_ratio(theta_l * e.exner, e.p_pa)
+    // Unsaturated below the base. The cap depends on q_t itself through
+    // the moist adiabat's exponent; two fixed-point passes from the
+    // surface air's water settle it to far below a part in a million.
+    let mut cap = atm.at(z0).qt;
+    for _ in 0..3 {
+        cap = saturation_mixing_ratio(unsaturated_temperature(theta_l, cap, e.p_pa), e.p_pa);
+    }
+    cap
 }
 
 /// Places parcel `i` for its `generation`-th life: seeded position and

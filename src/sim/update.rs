@@ -7,7 +7,8 @@
 //!    same for the horizontal velocity relative to the wind.
 //! 2. Drift: move the parcel (periodic in the plane, ground and table top
 //!    stop it).
-//! 3. Entrainment: exact exponential relaxation of `θ_l`, `q_t` and the
+//! 3. Entrainment: exact exponential relaxation of `θ_l` (Emanuel's exact
+//!    one, `thermo`), `q_t` and the
 //!    horizontal velocity towards the environment at the new height.
 //! 4. Saturation adjustment at the new pressure (implicit, iterated).
 //! 5. Detrainment: cloud water shed exponentially, faster when negatively
@@ -22,9 +23,11 @@ use glam::{DVec2, DVec3};
 
 use super::atmosphere::{Atmosphere, EnvSample};
 use super::config::PhysicsConfig;
-use super::constants::{C_P, G, L_V};
+use super::constants::G;
 use super::parcels::{Diag, Life};
-use super::thermo::{saturation_adjust, virtual_potential_temperature};
+use super::thermo::{
+    liquid_water_potential_temperature, saturation_adjust, virtual_potential_temperature,
+};
 
 /// Per-frame constants of the per-parcel update.
 #[derive(Clone, Copy)]
@@ -58,7 +61,7 @@ fn wind_with_direction(cfg: &PhysicsConfig, dir: DVec2, z_m: f64) -> DVec2 {
 
 #[inline]
 pub(super) fn diagnose(env: &EnvSample, theta_l: f64, qt: f64) -> Diag {
-    let a = saturation_adjust(theta_l, qt, env.p_pa, env.exner);
+    let a = saturation_adjust(theta_l, qt, env.p_pa);
     let theta_v = virtual_potential_temperature(a.t_k / env.exner, a.qv, a.qc);
     Diag {
         t_k: a.t_k,
@@ -189,11 +192,11 @@ pub(super) fn advance_parcel(
             };
         let shed = d.qc * -(-rate * dt).exp_m1();
         *qt -= shed;
-        // Liquid leaves at the parcel's temperature: θ is unchanged, θ_l rises.
-        *theta_l += L_V * shed / (C_P * env.exner);
-        life.detrained_kg.add(shed * life.mass_kg);
-        // Same as re-adjusting: T and q_v (= q_s(T)) are unchanged.
         d.qc -= shed;
+        // Liquid leaves at the parcel's temperature and pressure: T and
+        // q_v (= q_s(T)) are unchanged, θ_l of what stays rises.
+        *theta_l = liquid_water_potential_temperature(d.t_k, env.p_pa, *qt, d.qc);
+        life.detrained_kg.add(shed * life.mass_kg);
         d.theta_v = virtual_potential_temperature(d.t_k / env.exner, d.qv, d.qc);
         d.buoyancy = G * (d.theta_v - env.theta_v) / env.theta_v;
     }
