@@ -1,7 +1,7 @@
 //! One physics frame (default dt, SPH, entrainment, detrainment, recycling,
-//! wind all on) with 12 to 10,000 parcels, and the projection into P.
+//! wind all on) with 12 to 100,000 parcels, and the projection into P.
 //! The domain keeps one parcel per km² (12 parcels: 3.5 km square; 10,000:
-//! 100 km), the parcels are spun up for 20 minutes first so they are
+//! 100 km; 100,000: 316 km), the parcels are spun up for 20 minutes first so they are
 //! released, rising and condensing.
 //!
 //! Also `lcl` + the pseudo-adiabatic profile (`lift_sounding`, what
@@ -41,7 +41,7 @@ const BAND: Band = Band {
 
 fn physics(c: &mut Criterion) {
     let mut g = c.benchmark_group("step");
-    for n in [12, 100, 1000, 10_000] {
+    for n in [12, 100, 1000, 10_000, 100_000] {
         let mut sim = spun_up(n);
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| sim.step())
@@ -49,7 +49,7 @@ fn physics(c: &mut Criterion) {
     }
     g.finish();
     let mut g = c.benchmark_group("project_128");
-    for n in [12, 1000, 10_000] {
+    for n in [12, 1000, 10_000, 100_000] {
         let sim = spun_up(n);
         let mut field = ProjectedField::new(128, 128);
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
@@ -74,7 +74,7 @@ fn physics(c: &mut Criterion) {
 fn sph_crossover(c: &mut Criterion) {
     use cumulus::sim::sph::{NeighbourGrid, SphParams, accelerations};
     let mut g = c.benchmark_group("sph_crossover");
-    for n in [128usize, 256, 512, 1024, 4096] {
+    for n in [128usize, 256, 512, 1024, 2048, 4096] {
         let sim = spun_up(n);
         let p = sim.parcels();
         let active: Vec<u32> = (0..n as u32)

@@ -21,7 +21,7 @@ use super::kernels::{Kernel, Poly6, Spiky, Viscosity};
 /// cores (rayon); below it the thread hand-off costs more than it saves.
 /// The crossover is measured by `cargo bench --bench physics -- sph_crossover`
 /// (README, Speed).
-pub const PARALLEL_THRESHOLD: usize = 512;
+pub const PARALLEL_THRESHOLD: usize = 2048;
 
 /// Parameters of one SPH evaluation.
 #[derive(Debug, Clone, Copy)]
@@ -45,16 +45,27 @@ fn floor_i64(v: f64) -> i64 {
 }
 
 /// Most cells the grid may have per active parcel (plus a fixed 4096).
-pub const CELLS_PER_PARCEL: usize = 8;
+pub const CELLS_PER_PARCEL: usize = 2;
 
 /// Reusable neighbour grid.
 #[derive(Debug, Clone, Default)]
 pub struct NeighbourGrid {
     starts: Vec<u32>,
+    /// Parcel index of each slot (slots are in cell order).
     order: Vec<u32>,
     keys: Vec<u32>,
+    fill: Vec<u32>,
+    /// Positions and velocities copied into slot order, so a query reads
+    /// its candidates contiguously.
+    pos: Vec<DVec3>,
+    vel: Vec<DVec3>,
+    /// Per slot: density, and `p/ρ²`.
     density: Vec<f64>,
-    pressure: Vec<f64>,
+    p_rho2: Vec<f64>,
+    acc: Vec<DVec3>,
+    /// Per chunk of queries: the neighbour pairs pass 1 found (kept from
+    /// step to step, so a step allocates nothing once warm).
+    chunks: Vec<ChunkPairs>,
     nx: i64,
     nz: i64,
     cell_xy: f64,
@@ -78,8 +89,9 @@ impl NeighbourGrid {
         ((iz * self.nx + iy) * self.nx + ix) as usize
     }
 
-    /// Sorts the active parcels into cells.
-    fn build(&mut self, pos: &[DVec3], active: &[u32], p: &SphParams) {
+    /// Sorts the active parcels into cells and copies their positions and
+    /// velocities into slot order.
+    fn build(&mut self, pos: &[DVec3], vel: &[DVec3], active: &[u32], p: &SphParams) {
         self.h = p.h;
         let z_max = active
             .iter()
@@ -114,28 +126,30 @@ impl NeighbourGrid {
         }
         self.order.clear();
         self.order.resize(active.len(), 0);
-        let mut fill = self.starts.clone();
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.starts);
         for (k, &i) in active.iter().enumerate() {
             let c = self.keys[k] as usize;
-            self.order[fill[c] as usize] = i;
-            fill[c] += 1;
+            self.order[self.fill[c] as usize] = i;
+            self.fill[c] += 1;
         }
+        self.pos.clear();
+        self.pos.extend(self.order.iter().map(|&i| pos[i as usize]));
+        self.vel.clear();
+        self.vel.extend(self.order.iter().map(|&i| vel[i as usize]));
     }
 
-    /// Calls `f(j, x_i - x_j, r)` for every other active parcel `j` with
-    /// `r < h` (minimum-image distance in the periodic plane).
+    /// Calls `f(j, x_i - x_j, r)` for the slot `j` of every other active
+    /// parcel with `r < h` from the parcel in slot `i` (minimum-image
+    /// distance in the periodic plane).
     #[inline]
-    fn for_each_neighbour(
-        &self,
-        i: usize,
-        pos: &[DVec3],
-        l: f64,
-        mut f: impl FnMut(usize, DVec3, f64),
-    ) {
+    fn for_each_neighbour(&self, i: usize, l: f64, mut f: impl FnMut(usize, DVec3, f64)) {
+        let pos = &self.pos;
         let pi = pos[i];
         // The cells the sphere of radius h around the parcel overlaps, per
         // axis (at most 3, as cells are at least h wide), wrapped in the
-        // plane and each visited once.
+        // plane and each visited once. Along x they are contiguous in
+        // memory, so each (y, z) row is read as at most two runs of cells.
         let span = |lo_m: f64, hi_m: f64, cell: f64, n: i64, wrap: bool| {
             let (lo, hi) = (floor_i64(lo_m / cell), floor_i64(hi_m / cell));
             let mut v = [0i64; 3];
@@ -156,22 +170,38 @@ impl NeighbourGrid {
             }
             (v, m)
         };
-        let (xs, mx) = span(pi.x - self.h, pi.x + self.h, self.cell_xy, self.nx, true);
+        let x_runs = {
+            let (lo, hi) = (
+                floor_i64((pi.x - self.h) / self.cell_xy),
+                floor_i64((pi.x + self.h) / self.cell_xy),
+            );
+            let n = self.nx;
+            if hi - lo + 1 >= n {
+                ([(0, n - 1), (0, -1)], 1)
+            } else {
+                let (a, b) = (lo.rem_euclid(n), hi.rem_euclid(n));
+                if a <= b {
+                    ([(a, b), (0, -1)], 1)
+                } else {
+                    ([(a, n - 1), (0, b)], 2)
+                }
+            }
+        };
         let (ys, my) = span(pi.y - self.h, pi.y + self.h, self.cell_xy, self.nx, true);
         let (zs, mz) = span(pi.z - self.h, pi.z + self.h, self.cell_z, self.nz, false);
         let h2 = self.h * self.h;
         let half = 0.5 * l;
         for &iz in &zs[..mz] {
             for &iy in &ys[..my] {
-                for &ix in &xs[..mx] {
-                    let c = self.index(ix, iy, iz);
-                    let (s, e) = (self.starts[c] as usize, self.starts[c + 1] as usize);
-                    for &j in &self.order[s..e] {
-                        let j = j as usize;
+                for &(a, b) in &x_runs.0[..x_runs.1] {
+                    let s = self.starts[self.index(a, iy, iz)] as usize;
+                    let e = self.starts[self.index(b, iy, iz) + 1] as usize;
+                    for (j, &pj) in pos[s..e].iter().enumerate() {
+                        let j = s + j;
                         if j == i {
                             continue;
                         }
-                        let mut d = pi - pos[j];
+                        let mut d = pi - pj;
                         // Minimum image in the periodic plane (|d| < l before).
                         if d.x > half {
                             d.x -= l;
@@ -217,106 +247,117 @@ pub fn accelerations(
     if active.is_empty() {
         return;
     }
-    grid.build(pos, active, p);
-    let n = pos.len();
+    grid.build(pos, vel, active, p);
+    let m = active.len();
     let rho0 = Poly6::w(0.0, p.h);
     let c2 = p.sound_speed * p.sound_speed;
     let l = p.domain_m;
+    let chunk_count = m.div_ceil(QUERY_CHUNK);
+    let mut chunks = std::mem::take(&mut grid.chunks);
+    chunks.resize_with(chunk_count, ChunkPairs::default);
+    let mut density_v = std::mem::take(&mut grid.density);
+    density_v.resize(m, 0.0);
+    let mut p_rho2_v = std::mem::take(&mut grid.p_rho2);
+    p_rho2_v.resize(m, 0.0);
+    let mut acc_sorted = std::mem::take(&mut grid.acc);
+    acc_sorted.resize(m, DVec3::ZERO);
 
-    // Pass 1, density: each chunk of queries (in cell order, so consecutive
-    // queries read the same cells) walks the grid once and keeps its
-    // neighbour pairs for pass 2.
-    let density_chunk = |queries: &[u32]| {
-        let mut out = ChunkPairs::default();
-        for &i in queries {
+    // Pass 1, density: each chunk of queries (slots in cell order, so
+    // consecutive queries read the same cells) walks the grid once and
+    // keeps its neighbour pairs for pass 2.
+    let g: &NeighbourGrid = grid;
+    let density_chunk = |(c, ((rho_out, pr_out), out)): DensityChunk| {
+        out.pairs.clear();
+        out.ends.clear();
+        for (k, (rho_k, pr_k)) in rho_out.iter_mut().zip(pr_out.iter_mut()).enumerate() {
             let mut rho = rho0;
-            grid.for_each_neighbour(i as usize, pos, l, |j, d, r| {
+            g.for_each_neighbour(c * QUERY_CHUNK + k, l, |j, d, r| {
                 rho += Poly6::w(r, p.h);
                 out.pairs.push(Pair { j: j as u32, d, r });
             });
             out.ends.push(out.pairs.len() as u32);
-            out.rho.push(rho);
+            *rho_k = rho;
+            *pr_k = c2 * (rho - rho0).max(0.0) / (rho * rho);
         }
-        out
     };
-    let queries = &grid.order;
-    let chunks: Vec<ChunkPairs> = if parallel {
-        queries.par_chunks(QUERY_CHUNK).map(density_chunk).collect()
+    if parallel {
+        density_v
+            .par_chunks_mut(QUERY_CHUNK)
+            .zip(p_rho2_v.par_chunks_mut(QUERY_CHUNK))
+            .zip(chunks.par_iter_mut())
+            .enumerate()
+            .for_each(density_chunk);
     } else {
-        queries.chunks(QUERY_CHUNK).map(density_chunk).collect()
-    };
-    let mut density = std::mem::take(&mut grid.density);
-    let mut pressure = std::mem::take(&mut grid.pressure);
-    density.clear();
-    density.resize(n, rho0);
-    pressure.clear();
-    pressure.resize(n, 0.0);
-    for (qs, c) in queries.chunks(QUERY_CHUNK).zip(&chunks) {
-        for (&i, &r) in qs.iter().zip(&c.rho) {
-            density[i as usize] = r;
-            pressure[i as usize] = c2 * (r - rho0).max(0.0);
-        }
+        density_v
+            .chunks_mut(QUERY_CHUNK)
+            .zip(p_rho2_v.chunks_mut(QUERY_CHUNK))
+            .zip(chunks.iter_mut())
+            .enumerate()
+            .for_each(density_chunk);
     }
 
     // Pass 2, forces, over the kept pairs.
-    let force_chunk = |(qs, c): (&[u32], &ChunkPairs)| {
+    let (density, p_rho2) = (&density_v[..], &p_rho2_v[..]);
+    let vel_sorted = &g.vel;
+    let force_chunk = |(c, (acc_out, pairs)): (usize, (&mut [DVec3], &ChunkPairs))| {
         let mut start = 0usize;
-        qs.iter()
-            .zip(&c.ends)
-            .map(|(&i, &end)| {
-                let i = i as usize;
-                let (pi_rho2, vi) = (pressure[i] / (density[i] * density[i]), vel[i]);
-                let mut a = DVec3::ZERO;
-                for pair in &c.pairs[start..end as usize] {
-                    let j = pair.j as usize;
-                    let pj_rho2 = pressure[j] / (density[j] * density[j]);
-                    a -= Spiky::grad_w(pair.d, pair.r, p.h) * (pi_rho2 + pj_rho2);
-                    a += (vel[j] - vi)
-                        * (p.viscosity * Viscosity::laplacian(pair.r, p.h) / density[j]);
-                }
-                start = end as usize;
-                (i as u32, a)
-            })
-            .collect::<Vec<_>>()
+        for (k, (a_out, &end)) in acc_out.iter_mut().zip(&pairs.ends).enumerate() {
+            let i = c * QUERY_CHUNK + k;
+            let (pi_rho2, vi) = (p_rho2[i], vel_sorted[i]);
+            let mut a = DVec3::ZERO;
+            for pair in &pairs.pairs[start..end as usize] {
+                let j = pair.j as usize;
+                a -= Spiky::grad_w(pair.d, pair.r, p.h) * (pi_rho2 + p_rho2[j]);
+                a += (vel_sorted[j] - vi)
+                    * (p.viscosity * Viscosity::laplacian(pair.r, p.h) / density[j]);
+            }
+            start = end as usize;
+            *a_out = a;
+        }
     };
-    let out: Vec<Vec<(u32, DVec3)>> = if parallel {
-        queries
-            .par_chunks(QUERY_CHUNK)
+    if parallel {
+        acc_sorted
+            .par_chunks_mut(QUERY_CHUNK)
             .zip(chunks.par_iter())
-            .map(force_chunk)
-            .collect()
+            .enumerate()
+            .for_each(force_chunk);
     } else {
-        queries
-            .chunks(QUERY_CHUNK)
+        acc_sorted
+            .chunks_mut(QUERY_CHUNK)
             .zip(chunks.iter())
-            .map(force_chunk)
-            .collect()
-    };
-    for (i, a) in out.into_iter().flatten() {
+            .enumerate()
+            .for_each(force_chunk);
+    }
+    for (&i, &a) in grid.order.iter().zip(&acc_sorted) {
         acc[i as usize] = a;
     }
-    grid.density = density;
-    grid.pressure = pressure;
+    grid.density = density_v;
+    grid.p_rho2 = p_rho2_v;
+    grid.acc = acc_sorted;
+    grid.chunks = chunks;
 }
+
+/// One chunk of pass 1's work: its index, its slots' densities and `p/ρ²`
+/// to write, and its pair list to refill.
+type DensityChunk<'a> = (usize, ((&'a mut [f64], &'a mut [f64]), &'a mut ChunkPairs));
 
 /// Queries per unit of parallel work.
 const QUERY_CHUNK: usize = 128;
 
-/// A neighbour found in pass 1: index, `x_i - x_j`, distance.
-#[derive(Clone, Copy)]
+/// A neighbour found in pass 1: slot, `x_i - x_j`, distance.
+#[derive(Debug, Clone, Copy)]
 struct Pair {
     j: u32,
     d: DVec3,
     r: f64,
 }
 
-/// The pairs and densities of one chunk of queries.
-#[derive(Default)]
+/// The pairs of one chunk of queries.
+#[derive(Debug, Clone, Default)]
 struct ChunkPairs {
     pairs: Vec<Pair>,
     /// End of each query's pairs in `pairs`.
     ends: Vec<u32>,
-    rho: Vec<f64>,
 }
 
 #[cfg(test)]
@@ -357,10 +398,11 @@ mod tests {
             let active: Vec<u32> = (0..pos.len() as u32).collect();
             let mut grid = NeighbourGrid::default();
             let p = params(domain);
-            grid.build(&pos, &active, &p);
-            for i in 0..pos.len() {
+            grid.build(&pos, &pos, &active, &p);
+            for slot in 0..pos.len() {
+                let i = grid.order[slot] as usize;
                 let mut found = Vec::new();
-                grid.for_each_neighbour(i, &pos, domain, |j, _, _| found.push(j));
+                grid.for_each_neighbour(slot, domain, |j, _, _| found.push(grid.order[j] as usize));
                 found.sort_unstable();
                 assert_eq!(
                     found,
