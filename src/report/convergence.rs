@@ -235,7 +235,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
             vec![(
                 r.wall_s.max(1e-6),
                 r.err_z_m.max(floor),
-                format!("  least cost meeting the target: dt = {} s", r.dt_s),
+                format!("least cost meeting the target: dt = {} s", r.dt_s),
             )]
         })
         .unwrap_or_default();

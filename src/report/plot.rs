@@ -117,19 +117,14 @@ pub fn loglog_png(
                 .map_err(|e| err(&e))?;
         }
         for (x, y, label) in marked {
+            // The label starts beside the ring (a pixel offset, so it never
+            // runs under the ring whatever the axes' scale).
             chart
-                .draw_series(std::iter::once(Circle::new(
-                    (*x, *y),
-                    9,
-                    BLACK.stroke_width(2),
-                )))
-                .map_err(|e| err(&e))?;
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    label.clone(),
-                    (*x, *y),
-                    ("sans-serif", 15),
-                )))
+                .draw_series(std::iter::once(
+                    EmptyElement::at((*x, *y))
+                        + Circle::new((0, 0), 9, BLACK.stroke_width(2))
+                        + Text::new(label.clone(), (14, -8), ("sans-serif", 15)),
+                ))
                 .map_err(|e| err(&e))?;
         }
         chart

@@ -135,7 +135,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
             vec![(
                 r.wall_s.max(1e-6),
                 (r.mean_error as f64).max(1e-6),
-                format!("  least cost meeting the target: {} steps", r.steps),
+                format!("least cost meeting the target: {} steps", r.steps),
             )]
         })
         .unwrap_or_default();
