@@ -18,7 +18,7 @@ pub(super) fn air_mass(env: &EnvSample, radius_m: f64) -> f64 {
 }
 
 /// The most total water a released parcel may carry, kg/kg: the saturation
-/// mixing ratio where the parcel, lifted dry-adiabatically from the release
+/// mixing ratio where the parcel, lifted unsaturated (moist air's adiabat) from the release
 /// height with its `θ_l` excess, reaches the surface air's LCL (the cloud
 /// base). With at most this much water a parcel cannot saturate below the
 /// cloud base, however small the saturation mixing ratio of cold air is
@@ -29,8 +29,8 @@ pub(super) fn release_qt_cap(cfg: &PhysicsConfig, atm: &Atmosphere) -> f64 {
     let base = surface_lcl_height(atm).unwrap_or(atm.top_m()).max(z0);
     let e = atm.at(base);
     // Unsaturated below the base. The cap depends on q_t itself through
-    // the moist adiabat's exponent; two fixed-point passes from the
-    // surface air's water settle it to far below a part in a million.
+    // the moist adiabat's exponent; three fixed-point passes from the
+    // release-height air's water settle it to far below a part in a million.
     let mut cap = atm.at(z0).qt;
     for _ in 0..3 {
         cap = saturation_mixing_ratio(unsaturated_temperature(theta_l, cap, e.p_pa), e.p_pa);

@@ -13,7 +13,8 @@
 //! height (the linearised `T = Π θ_l + L_v q_c / c_p` used before ran 7 K
 //! too warm at 12 km in a tropical column). Unsaturated air rises on the
 //! adiabat of moist air, `T ∝ p^χ` with `χ = (R_d + r_t R_v)/(c_pd + r_t
-//! c_pv)`, the adiabat the LCL (Romps 2017) is computed on.
+//! c_pv)`, the adiabat the LCL (Romps 2017) is computed on (up to the
+//! fifth digit of R_v: Ambaum's here, 461.5 J/(kg K) in `lift`).
 
 use super::constants::{C_P, EPSILON, KAPPA, L_V, P0, R_D, VIRTUAL_COEFF, ZERO_CELSIUS_K};
 
@@ -172,7 +173,8 @@ impl MoistExponents {
 /// `rl` is condensate (mixing ratios, kg/kg).
 #[inline]
 fn ln_theta_l(x: &MoistExponents, ln_t: f64, t: f64, p_pa: f64, rt: f64, rl: f64) -> f64 {
-    let rv = rt - rl;
+    // All water condensed (only where e_s underflows): keep ln r_v finite.
+    let rv = (rt - rl).max(f64::MIN_POSITIVE);
     let mut y = ln_t + x.chi * ((P0 / p_pa) * (EPSILON + rv) / (EPSILON + rt)).ln();
     if rl > 0.0 {
         y -= x.gamma * (rv / rt).ln() + latent_heat_at(t) * rl / (x.c * t);
@@ -216,11 +218,10 @@ pub struct Adjusted {
     pub qc: f64,
 }
 
-/// Most Newton iterations of the saturation adjustment (it stops earlier
-/// once a step is below 1e-9 K). From the linearised first guess three
-/// reach round-off in cumulus conditions (tested in
-/// `saturation_adjustment_converges`).
-pub const ADJUST_ITERATIONS: usize = 8;
+/// Most iterations of the saturation adjustment (it stops once a step is
+/// below 1e-9 K). Newton from the linearised guess takes 3-6 in cumulus and
+/// tropical columns; the bracket's bisection steps bound the rest.
+pub const ADJUST_ITERATIONS: usize = 40;
 
 /// Saturation adjustment: given the conserved `θ_l` (K) and `q_t` (kg/kg) at
 /// pressure `p_pa`, find `T`, `q_v`, `q_c` such that
@@ -228,9 +229,12 @@ pub const ADJUST_ITERATIONS: usize = 8;
 /// `q_c = 0` (sub-saturated) or `q_v = q_s(T, p)`.
 ///
 /// Implicit: Newton on `T` for `ln θ_l` with its exact derivative, from the
-/// linearised guess `T_u + L_v Δq / (c_p (1 + L_v q_s' / c_p))`, kept inside
-/// the bracket `[T_u, T_u + L_v q_t / c_p]` (`T_u` the unsaturated
-/// temperature). Stable for any step; exact in `q_t` (`q_v + q_c == q_t`).
+/// linearised guess `T_u + L_v Δq / (c (1 + L_v q_s' / c))` (`T_u` the
+/// unsaturated temperature, `c = c_pd + r_t c_pv`), safeguarded by a
+/// bracket that every evaluation narrows: it starts as `[T_u, T_u + 1.01
+/// L_v(T_u) q_t / c]`, and a Newton step that leaves it, or lands where all
+/// the water would be vapour, is replaced by bisection. Stable for any
+/// state; exact in `q_t` (`q_v + q_c == q_t`).
 #[inline]
 pub fn saturation_adjust(theta_l: f64, qt: f64, p_pa: f64) -> Adjusted {
     let qt = qt.max(0.0);
@@ -239,15 +243,18 @@ pub fn saturation_adjust(theta_l: f64, qt: f64, p_pa: f64) -> Adjusted {
     let t_u = theta_l * (x.chi * (ln_p - P0.ln())).exp();
     // Unsaturated at the unsaturated temperature: no condensate at all.
     let (qs_u, dqs_u) = saturation_mixing_ratio_and_slope(t_u, p_pa);
-    if qt <= qs_u {
+    if qt <= qs_u || !t_u.is_finite() {
         return Adjusted {
             t_k: t_u,
             qv: qt,
             qc: 0.0,
         };
     }
+    // At T_u, with condensate, ln θ_l is below the target; at the
+    // temperature where all the water is vapour it is above (f > 0 there),
+    // and the root is below T_u + L_v(T_u) q_t / c (L_v falls with T).
     let l_c = L_V / x.c;
-    let (lo, hi) = (t_u, t_u + l_c * qt);
+    let (mut lo, mut hi) = (t_u, t_u + 1.01 * latent_heat_at(t_u) * qt / x.c);
     let mut t = (t_u + l_c * (qt - qs_u) / (1.0 + l_c * dqs_u)).clamp(lo, hi);
     // Saturated, with e = e_s(T) and p_d = p - e: ε + q_s = ε p / p_d and
     // ln q_s = ln ε + ln e - ln p_d, so
@@ -256,7 +263,7 @@ pub fn saturation_adjust(theta_l: f64, qt: f64, p_pa: f64) -> Adjusted {
     let c0 =
         x.chi * (P0.ln() + EPSILON.ln() - (EPSILON + qt).ln()) - x.gamma * (EPSILON.ln() - qt.ln());
     let target = theta_l.ln() - c0;
-    let (mut qs, mut dqs_last, mut last_step) = (qs_u, 0.0, 0.0);
+    let (mut qs, mut dqs_last, mut last_step) = (qs_u, 0.0, f64::INFINITY);
     for _ in 0..ADJUST_ITERATIONS {
         let ln_t = t.ln();
         let ln_e = ln_saturation_vapour_pressure(t, ln_t);
@@ -267,32 +274,46 @@ pub fn saturation_adjust(theta_l: f64, qt: f64, p_pa: f64) -> Adjusted {
         } else {
             qt
         };
-        if q >= qt {
-            // At or past saturation of all the water: back towards the
-            // unsaturated end of the bracket.
-            t = 0.5 * (t + lo);
+        let next = if q >= qt {
+            // All the water would be vapour: above the root.
+            hi = t;
             last_step = f64::INFINITY;
-            continue;
-        }
-        let ln_pd = pd.ln();
-        let rl = qt - q;
-        let lv = latent_heat_at(t);
-        let inv_ct = 1.0 / (x.c * t);
-        let f = ln_t - x.chi * ln_pd - x.gamma * (ln_e - ln_pd) - lv * rl * inv_ct - target;
-        let dqs = q * p_pa / pd * lv / (ambaum::R_V * t * t);
-        let slope = 1.0 / t + x.chi * dqs / (EPSILON + q) - x.gamma * dqs / q
-            + ((ambaum::CP_L - ambaum::CP_V) * rl + lv * dqs) * inv_ct
-            + lv * rl * inv_ct / t;
-        let step = f / slope;
-        let next = (t - step).clamp(lo, hi);
-        (qs, dqs_last, last_step) = (q, dqs, next - t);
+            0.5 * (lo + hi)
+        } else {
+            let ln_pd = pd.ln();
+            let rl = qt - q;
+            let lv = latent_heat_at(t);
+            let inv_ct = 1.0 / (x.c * t);
+            let f = ln_t - x.chi * ln_pd - x.gamma * (ln_e - ln_pd) - lv * rl * inv_ct - target;
+            if f < 0.0 {
+                lo = t;
+            } else {
+                hi = t;
+            }
+            // dq_s/dT = q_s (p / p_d) L / (R_v T²); the χ and γ terms in
+            // closed form (no division by q_s, which can underflow).
+            let k = lv / (ambaum::R_V * t * t);
+            let dqs = q * p_pa / pd * k;
+            let slope = 1.0 / t + x.chi * e / pd * k - x.gamma * p_pa / pd * k
+                + ((ambaum::CP_L - ambaum::CP_V) * rl + lv * dqs) * inv_ct
+                + lv * rl * inv_ct / t;
+            let newton = t - f / slope;
+            let next = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            (qs, dqs_last, last_step) = (q, dqs, next - t);
+            next
+        };
+        let moved = (next - t).abs();
         t = next;
-        if step.abs() < 1e-9 {
+        if moved < 1e-9 || hi - lo < 1e-9 {
             break;
         }
     }
-    // q_s at the final T: the last step is below 1e-9 K, so the linear
-    // update is exact to round-off (a full re-evaluation if it was not).
+    // q_s at the final T: after a step below 1e-6 K the linear update is
+    // exact to round-off; otherwise it is evaluated again.
     let qs = if last_step.abs() < 1e-6 {
         (qs + dqs_last * last_step).min(qt)
     } else {
@@ -352,12 +373,24 @@ mod tests {
             (260.0, 50_000.0, 2e-3),
             (220.0, 15_000.0, 1e-3),
             (240.0, 80_000.0, 1e-6),
+            // Extreme air (q_t 40-80 g/kg aloft, found to 2-cycle an
+            // unbracketed Newton) and cold air where L_v(T) > L_v(T_0).
+            (288.3, 32_000.0, 0.03),
+            (300.0, 50_000.0, 0.05),
+            (305.0, 60_000.0, 0.02),
+            (160.0, 10_000.0, 1e-5),
+            (150.0, 5_000.0, 1e-6),
         ] {
             let qs = saturation_mixing_ratio(t, p);
             let qt = qs + extra;
             let theta_l = liquid_water_potential_temperature(t, p, qt, extra);
             let a = saturation_adjust(theta_l, qt, p);
             assert!((a.t_k - t).abs() < 1e-7, "{t} K {p} Pa: {}", a.t_k);
+            let back = liquid_water_potential_temperature(a.t_k, p, qt, a.qc);
+            assert!(
+                (back - theta_l).abs() < 1e-9 * theta_l,
+                "{t} K {p} Pa: θ_l {back}"
+            );
             assert!(
                 (a.qc - extra).abs() < 1e-10 * qt.max(1e-3),
                 "{} vs {extra}",
