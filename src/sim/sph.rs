@@ -470,6 +470,38 @@ mod tests {
     }
 
     #[test]
+    fn a_reused_grid_gives_what_a_fresh_one_gives() {
+        // The grid keeps its buffers from call to call: shrinking and
+        // scattered active sets must not read anything stale.
+        let pos: Vec<DVec3> = (0..800)
+            .map(|i| {
+                let u = |s| crate::sim::parcels::keyed_uniform(9, i, 0, s);
+                DVec3::new(u(0) * 2000.0, u(1) * 2000.0, u(2) * 300.0)
+            })
+            .collect();
+        let vel: Vec<DVec3> = (0..800)
+            .map(|i| DVec3::new(0.0, i as f64 * 1e-3, 0.0))
+            .collect();
+        let sets: [Vec<u32>; 3] = [
+            (0..800).collect(),
+            (0..300).collect(),
+            (0..800).filter(|i| i % 7 == 3).collect(),
+        ];
+        let mut reused = NeighbourGrid::default();
+        for (k, active) in sets.iter().enumerate() {
+            for parallel in [false, true] {
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                let p = params(2000.0);
+                accelerations(&mut reused, &pos, &vel, active, &p, parallel, &mut a);
+                let mut fresh = NeighbourGrid::default();
+                accelerations(&mut fresh, &pos, &vel, active, &p, parallel, &mut b);
+                assert_eq!(a, b, "set {k}, parallel {parallel}");
+                assert!(a.iter().any(|x| x.length() > 0.0), "set {k} has contacts");
+            }
+        }
+    }
+
+    #[test]
     fn coincident_parcels_stay_finite() {
         let pos = vec![DVec3::new(10.0, 10.0, 10.0); 50];
         let vel = vec![DVec3::ZERO; 50];
