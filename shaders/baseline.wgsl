@@ -13,6 +13,43 @@ struct Sphere {
 
 @group(1) @binding(0) var<storage, read> spheres: array<Sphere>;
 
+// The baseline's own procedural detail noise (the value noise the cloud
+// pass used before its 3D volume), so the baseline needs no textures.
+fn sphere_hash(x: i32, y: i32, z: i32) -> f32 {
+    var h = (bitcast<u32>(x) * 0x8da6b343u) ^ (bitcast<u32>(y) * 0xd8163841u)
+        ^ (bitcast<u32>(z) * 0xcb1ab31fu);
+    h ^= h >> 13u;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15u;
+    return f32(h & 0x00ffffffu) / 16777216.0;
+}
+
+fn sphere_value_noise(q: vec3f) -> f32 {
+    let f = floor(q);
+    let t = q - f;
+    let w = t * t * (vec3f(3.0) - 2.0 * t);
+    let x = i32(f.x);
+    let y = i32(f.y);
+    let z = i32(f.z);
+    let x00 = mix(sphere_hash(x, y, z), sphere_hash(x + 1, y, z), w.x);
+    let x10 = mix(sphere_hash(x, y + 1, z), sphere_hash(x + 1, y + 1, z), w.x);
+    let x01 = mix(sphere_hash(x, y, z + 1), sphere_hash(x + 1, y, z + 1), w.x);
+    let x11 = mix(sphere_hash(x, y + 1, z + 1), sphere_hash(x + 1, y + 1, z + 1), w.x);
+    return mix(mix(x00, x10, w.y), mix(x01, x11, w.y), w.z);
+}
+
+fn sphere_noise(p: vec3f, scale_m: f32) -> f32 {
+    let q = p / scale_m;
+    return 0.5 * sphere_value_noise(q) + 0.3 * sphere_value_noise(q * 2.0 + vec3f(17.3))
+        + 0.2 * sphere_value_noise(q * 4.0 + vec3f(5.9));
+}
+
+// The baseline's per-pixel dither (interleaved gradient noise, Jimenez
+// 2014), so it needs no blue-noise texture.
+fn sphere_dither(x: u32, y: u32) -> f32 {
+    return fract(52.982918 * fract(0.06711056 * f32(x) + 0.00583715 * f32(y)));
+}
+
 // Extinction (1/m) at p: the sum of every sphere's parabolic profile,
 // eroded by the detail noise when it is on. O(parcels).
 fn sphere_density(p: vec3f, detail: bool) -> f32 {
@@ -32,7 +69,7 @@ fn sphere_density(p: vec3f, detail: bool) -> f32 {
         return 0.0;
     }
     if DETAIL && detail {
-        let n = detail_noise(p, frame.map.z);
+        let n = sphere_noise(p, frame.map.z);
         profile = max(profile - frame.map.y * n * (1.0 - profile), 0.0);
     }
     return frame.band.w * profile;
@@ -118,6 +155,6 @@ fn march_spheres(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
 @fragment
 fn fs_baseline(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let px = vec2u(pos.xy);
-    let c = march_spheres(frame.cam_pos.xyz, camera_ray(pos.xy), pixel_dither(px.x, px.y));
+    let c = march_spheres(frame.cam_pos.xyz, camera_ray(pos.xy), sphere_dither(px.x, px.y));
     return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);
 }

@@ -19,13 +19,20 @@ override DEBUG_COUNT: bool = false;
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
 const SURFACE_RAMP: f32 = 0.08;
-const DETAIL_CONTRAST: f32 = 2.6;
+const DETAIL_CONTRAST: f32 = 1.23;
 const WARP_SCALE_M: f32 = 9000.0;
 const WARP_AMPLITUDE_M: f32 = 1700.0;
 const WARP_RAMP_INNER: f32 = 0.72;
 const WARP_RAMP_OUTER: f32 = 1.3;
 const WEATHER_SCALE_M: f32 = 3000.0;
 const REFINE: u32 = 4u;
+const NEAR_M: f32 = 3000.0;
+const DETAIL_TILE: f32 = 4.0;
+const BILLOW_FREQUENCY: f32 = 1.618;
+const BASE_WEIGHT: f32 = 0.85;
+const NOISE_SIZE: f32 = 64.0;
+const NOISE_MAX_LOD: f32 = 5.0;
+const BLUE_NOISE_SIZE: u32 = 64u;
 const ALBEDO: f32 = 0.99;
 const MIN_TRANSMITTANCE: f32 = 0.01;
 const SUN_DISK_COS: f32 = 0.999989;
@@ -38,14 +45,14 @@ const RAY_DEPTH: f32 = 0.5;
 // camera is `View`'s (src/render/camera.rs): any perspective projection,
 // standard or reversed depth.
 struct Frame {
-    cam_pos: vec4f,      // eye xyz (m), unused
+    cam_pos: vec4f,      // eye xyz (m), pixel spread (rad)
     screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
     ambient_top: vec4f,  // sky_radiance(up) / 4, exposure
     sky_up: vec4f,       // sky_radiance(up), unused
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
-    map: vec4f,          // extent (m), detail strength, detail scale (m), unused
+    map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
     terrain: vec4f,      // extent (m), highest point (m), unused, unused
     counts: vec4u,       // steps, P width, P height, frame index
@@ -61,6 +68,8 @@ struct Frame {
 @group(0) @binding(2) var cm_tex: texture_2d<f32>;
 @group(0) @binding(3) var mask_tex: texture_2d<u32>;
 @group(0) @binding(4) var wrap_linear: sampler;
+@group(0) @binding(5) var noise_tex: texture_3d<f32>;
+@group(0) @binding(6) var blue_tex: texture_2d<f32>;
 
 fn height_fraction(y: f32) -> f32 {
     return (y - frame.band.x) / (frame.band.y - frame.band.x);
@@ -80,44 +89,56 @@ fn band_segment(origin: vec3f, dir: vec3f, bottom: f32, top: f32, max_t: f32) ->
     return vec2f(max(min(ta, tb), 0.0), min(max(ta, tb), max_t));
 }
 
-fn hash3(x: i32, y: i32, z: i32) -> f32 {
-    var h = (bitcast<u32>(x) * 0x8da6b343u) ^ (bitcast<u32>(y) * 0xd8163841u)
-        ^ (bitcast<u32>(z) * 0xcb1ab31fu);
-    h ^= h >> 13u;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15u;
-    return f32(h & 0x00ffffffu) / 16777216.0;
-}
-
 fn wrap_i(a: i32, period: i32) -> i32 {
     return ((a % period) + period) % period;
 }
 
-fn value_noise3(q: vec3f, period: i32) -> f32 {
-    let f = floor(q);
-    let t = q - f;
-    let w = t * t * (vec3f(3.0) - 2.0 * t);
-    let x = i32(f.x);
-    let y = i32(f.y);
-    let z = i32(f.z);
-    let x0 = wrap_i(x, period);
-    let x1 = wrap_i(x + 1, period);
-    let y0 = wrap_i(y, period);
-    let y1 = wrap_i(y + 1, period);
-    let z0 = wrap_i(z, period);
-    let z1 = wrap_i(z + 1, period);
-    let x00 = mix(hash3(x0, y0, z0), hash3(x1, y0, z0), w.x);
-    let x10 = mix(hash3(x0, y1, z0), hash3(x1, y1, z0), w.x);
-    let x01 = mix(hash3(x0, y0, z1), hash3(x1, y0, z1), w.x);
-    let x11 = mix(hash3(x0, y1, z1), hash3(x1, y1, z1), w.x);
-    return mix(mix(x00, x10, w.y), mix(x01, x11, w.y), w.z);
+fn lod_of(footprint_m: f32, texel_m: f32) -> f32 {
+    return round(max(log2(footprint_m / texel_m), 0.0));
 }
 
-fn detail_noise(p: vec3f, scale_m: f32) -> f32 {
-    let q = p / scale_m;
-    return 0.5 * value_noise3(q, 64)
-        + 0.3 * value_noise3(q * 2.0 + vec3f(17.3), 128)
-        + 0.2 * value_noise3(q * 4.0 + vec3f(5.9), 256);
+// The gain restoring a mip level's spread (the CPU's `noise_gain`).
+fn noise_gain(lod: f32) -> f32 {
+    if lod < 0.5 {
+        return 1.0;
+    } else if lod < 1.5 {
+        return 1.05;
+    } else if lod < 2.5 {
+        return 1.14;
+    } else if lod < 3.5 {
+        return 1.4;
+    } else if lod < 4.5 {
+        return 1.82;
+    }
+    return 2.56;
+}
+
+fn gained(value: f32, lod: f32) -> f32 {
+    return clamp(0.5 + (value - 0.5) * noise_gain(lod), 0.0, 1.0);
+}
+
+// The detail volume's base channel (the CPU's `detail_base`).
+fn detail_base(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
+    let tile_m = DETAIL_TILE * scale_m;
+    let texel_m = tile_m / NOISE_SIZE;
+    let lod = min(lod_of(footprint_m, texel_m), NOISE_MAX_LOD);
+    return gained(textureSampleLevel(noise_tex, wrap_linear, p / tile_m, lod).r, lod);
+}
+
+// The detail volume's billows channel (the CPU's `detail_billows`).
+fn detail_billows(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
+    let tile_m = DETAIL_TILE * scale_m;
+    let texel_m = tile_m / NOISE_SIZE;
+    let lod = min(lod_of(footprint_m * BILLOW_FREQUENCY, texel_m), NOISE_MAX_LOD);
+    let q = p * (BILLOW_FREQUENCY / tile_m) + vec3f(0.31, 0.17, 0.73);
+    return gained(textureSampleLevel(noise_tex, wrap_linear, q, lod).g, lod);
+}
+
+// The detail noise from the 3D volume at the footprint's level of detail
+// (the CPU's `detail_noise`).
+fn detail_noise(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
+    let base = detail_base(p, scale_m, footprint_m);
+    return BASE_WEIGHT * base + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m);
 }
 
 // True where the coarse max-coverage mask says no P texel near map
@@ -133,14 +154,14 @@ fn coarse_empty(u: f32, v: f32) -> bool {
     return textureLoad(mask_tex, c, 0).r == 0u;
 }
 
-// (cover, local top, fill, map value) at map coordinate uv (the CPU's
-// `footprint`).
-fn footprint(u: f32, v: f32) -> vec4f {
+// (cover, local top, fill, map value) at map coordinate uv, the map at
+// mip level map_lod (the CPU's `footprint`).
+fn footprint(u: f32, v: f32, map_lod: f32) -> vec4f {
     let pf = textureSampleLevel(p_tex, wrap_linear, vec2f(u, v), 0.0);
     if pf.r <= 1e-3 {
         return vec4f(0.0);
     }
-    let cm = textureSampleLevel(cm_tex, wrap_linear, vec2f(u, v), 0.0);
+    let cm = textureSampleLevel(cm_tex, wrap_linear, vec2f(u, v), map_lod);
     let cover = clamp(frame.band.z * pf.r, 0.0, 1.0);
     let top = clamp(0.2 + 0.8 * pf.g, 0.0, 1.0) * (0.7 + 0.3 * cm.g);
     return vec4f(cover, top, pf.b, cm.r);
@@ -177,23 +198,29 @@ fn weather(x: f32, z: f32) -> f32 {
 // domain warp, and the weight (the CPU's `warped_lookup`).
 fn warped_lookup(x: f32, z: f32) -> vec3f {
     let k = warp_weight(x, z);
+    if k <= 0.0 {
+        return vec3f(x / frame.map.x, z / frame.map.x, 0.0);
+    }
     let w = domain_warp(x, z) * k;
     return vec3f(x / frame.map.x + w.x, z / frame.map.x + w.y, k);
 }
 
 // The footprint at world (x, z) through the domain warp, the cover
-// modulated by the weather (the CPU's `world_footprint`).
-fn world_footprint(x: f32, z: f32) -> vec4f {
-    let l = warped_lookup(x, z);
+// modulated by the weather, the map at the footprint's level of detail
+// (the CPU's `world_footprint`).
+fn world_footprint(x: f32, z: f32, l: vec3f, footprint_m: f32) -> vec4f {
     let u = l.x;
     let v = l.y;
     let k = l.z;
     if coarse_empty(u, v) {
         return vec4f(0.0);
     }
-    let fp = footprint(u, v);
+    let fp = footprint(u, v, lod_of(footprint_m, frame.map.w));
     if fp.x <= 0.0 {
         return vec4f(0.0);
+    }
+    if k <= 0.0 {
+        return fp;
     }
     return vec4f(fp.x * mix(1.0, weather(x, z), k), fp.y, fp.z, fp.w);
 }
@@ -214,14 +241,48 @@ fn cloud_field(m: f32, n: f32, s: f32) -> f32 {
     return 0.5 + ((1.0 - s) * (m - 0.5) + s * (nn - 0.5)) / norm;
 }
 
+// The density profile where the field meets the threshold (the CPU's
+// `surface_profile`).
+fn surface_profile(m: f32, n: f32, s: f32, threshold: f32) -> f32 {
+    return clamp((cloud_field(m, n, s) - threshold) / SURFACE_RAMP, 0.0, 1.0);
+}
+
+// surface_profile of the detail noise, reading the volume only where it
+// can change the result (the CPU's `detail_profile`).
+fn detail_profile(p: vec3f, m: f32, threshold: f32, s: f32, scale_m: f32, footprint_m: f32) -> f32 {
+    if surface_profile(m, 0.0, s, threshold) >= 1.0 {
+        return 1.0;
+    }
+    let low = BASE_WEIGHT * detail_base(p, scale_m, footprint_m);
+    if surface_profile(m, low + (1.0 - BASE_WEIGHT), s, threshold) <= 0.0 {
+        return 0.0;
+    }
+    if surface_profile(m, low, s, threshold) >= 1.0 {
+        return 1.0;
+    }
+    let n = low + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m);
+    return surface_profile(m, n, s, threshold);
+}
+
+// Where p reads the detail volume: warped outside the simulated domain
+// (the CPU's `noise_point`).
+fn noise_point(p: vec3f, l: vec3f) -> vec3f {
+    if l.z <= 0.0 {
+        return p;
+    }
+    return vec3f(l.x * frame.map.x, p.y, l.y * frame.map.x);
+}
+
 // Extinction sigma_t (1/m) at p; `detail` false puts the detail noise's
-// mean in its place (shadow rays).
-fn density_at(p: vec3f, detail: bool) -> f32 {
+// mean in its place (shadow rays); the textures are read at the level of
+// detail of a pixel footprint `footprint_m` wide.
+fn density_at(p: vec3f, detail: bool, footprint_m: f32) -> f32 {
     let eta = height_fraction(p.y);
     if eta < 0.0 || eta > 1.0 {
         return 0.0;
     }
-    let fp = world_footprint(p.x, p.z);
+    let lookup = warped_lookup(p.x, p.z);
+    let fp = world_footprint(p.x, p.z, lookup, footprint_m);
     if fp.x <= 0.0 || eta >= fp.y {
         return 0.0;
     }
@@ -230,11 +291,13 @@ fn density_at(p: vec3f, detail: bool) -> f32 {
     if cloud_field(fp.w, 1.0, s) < threshold {
         return 0.0;
     }
-    var n = 0.5;
+    var profile = 0.0;
     if DETAIL && detail {
-        n = detail_noise(p, frame.map.z);
+        let q = noise_point(p, lookup);
+        profile = detail_profile(q, fp.w, threshold, s, frame.map.z, footprint_m);
+    } else {
+        profile = surface_profile(fp.w, 0.5, s, threshold);
     }
-    let profile = clamp((cloud_field(fp.w, n, s) - threshold) / SURFACE_RAMP, 0.0, 1.0);
     return frame.band.w * (0.3 + 0.7 * fp.z) * profile;
 }
 
@@ -248,7 +311,7 @@ fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
         + 0.25 * phase_hg(cos_theta, -0.3 * eccentricity);
 }
 
-fn sun_optical_depth(p: vec3f, sun_dir: vec3f) -> f32 {
+fn sun_optical_depth(p: vec3f, sun_dir: vec3f, footprint_m: f32) -> f32 {
     if SHADOW_STEPS == 0u {
         return 0.0;
     }
@@ -266,14 +329,14 @@ fn sun_optical_depth(p: vec3f, sun_dir: vec3f) -> f32 {
         if height_fraction(q.y) > 1.0 {
             break;
         }
-        tau += density_at(q, false) * dt;
+        tau += density_at(q, false, footprint_m) * dt;
         t += dt;
     }
     return tau;
 }
 
-fn sun_transmittance(p: vec3f, sun_dir: vec3f) -> f32 {
-    return exp(-sun_optical_depth(p, sun_dir));
+fn sun_transmittance(p: vec3f, sun_dir: vec3f, footprint_m: f32) -> f32 {
+    return exp(-sun_optical_depth(p, sun_dir, footprint_m));
 }
 
 fn sun_scattering(tau_sun: f32, cos_theta: f32) -> f32 {
@@ -337,8 +400,14 @@ fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {
     return vec3f(0.0);
 }
 
+// The blue-noise tile's offset of pixel (x, y) (the CPU's `pixel_dither`).
 fn pixel_dither(x: u32, y: u32) -> f32 {
-    return fract(52.982918 * fract(0.06711056 * f32(x) + 0.00583715 * f32(y)));
+    return textureLoad(blue_tex, vec2u(x % BLUE_NOISE_SIZE, y % BLUE_NOISE_SIZE), 0).r;
+}
+
+// The distance at march parameter s (the CPU's `march_distance`).
+fn march_distance(t0: f32, log_ratio: f32, s: f32) -> f32 {
+    return (t0 + NEAR_M) * exp(s * log_ratio) - NEAR_M;
 }
 
 fn tone_map(c: f32, exposure: f32) -> f32 {
@@ -382,7 +451,8 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let t1 = seg.y;
     let sun_dir = frame.sun_dir.xyz;
     let steps = max(frame.counts.x, 1u);
-    let dt = (t1 - t0) / f32(steps);
+    let log_ratio = log((t1 + NEAR_M) / (t0 + NEAR_M));
+    let spread = frame.cam_pos.w;
     let sun = frame.sun_light.xyz;
     let ambient_top = frame.ambient_top.xyz;
     let cos_theta = dot(dir, sun_dir);
@@ -390,28 +460,32 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
     var samples = 1u;
-    var sigma_a = density_at(origin + dir * t0, true);
+    var sigma_a = density_at(origin + dir * t0, true, spread * t0);
+    var ta = t0;
     for (var i = 0u; i < steps; i++) {
-        let ta = t0 + f32(i) * dt;
-        let sigma_b = density_at(origin + dir * (ta + dt), true);
+        let tb = march_distance(t0, log_ratio, f32(i + 1u) / f32(steps));
+        let sigma_b = density_at(origin + dir * tb, true, spread * tb);
         samples += 1u;
         let touched = sigma_a > 0.0 || sigma_b > 0.0;
         sigma_a = sigma_b;
         var n = 1u;
-        var h = dt;
+        var h = tb - ta;
         if touched {
             n = REFINE;
-            h = dt / f32(REFINE);
+            h = (tb - ta) / f32(REFINE);
         }
+        let start = ta;
+        ta = tb;
         for (var j = 0u; j < n; j++) {
-            let t = ta + (f32(j) + dither) * h;
+            let t = start + (f32(j) + dither) * h;
             let p = origin + dir * t;
-            let sigma_t = density_at(p, true);
+            let footprint = spread * t;
+            let sigma_t = density_at(p, true, footprint);
             samples += 1u;
             if sigma_t <= 0.0 {
                 continue;
             }
-            let tau_sun = sun_optical_depth(p, sun_dir);
+            let tau_sun = sun_optical_depth(p, sun_dir, footprint);
             samples += SHADOW_STEPS;
             let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
             let ambient = ambient_top * (0.35 + 0.65 * eta);

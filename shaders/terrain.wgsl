@@ -46,7 +46,7 @@ fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
     let dt = (seg.y - seg.x) / f32(n);
     var tau = 0.0;
     for (var i = 0u; i < n; i++) {
-        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), false) * dt;
+        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), false, 0.0) * dt;
     }
     return exp(-tau);
 }

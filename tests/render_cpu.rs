@@ -44,11 +44,11 @@ fn density_is_zero_outside_the_band_and_where_coverage_is_zero() {
     for i in 0..2000 {
         let (x, z) = ((i * 37 % 1000) as f32 * 10.0, (i * 91 % 1000) as f32 * 10.0);
         for y in [0.0, 599.0, 1601.0, 5000.0] {
-            assert_eq!(density_at(Vec3::new(x, y, z), &f, &D, true), 0.0);
+            assert_eq!(density_at(Vec3::new(x, y, z), &f, &D, true, 0.0), 0.0);
         }
         let p = Vec3::new(x, 700.0, z);
-        assert_eq!(density_at(p, &e, &D, true), 0.0);
-        inside += usize::from(density_at(p, &f, &D, true) > 0.0);
+        assert_eq!(density_at(p, &e, &D, true, 0.0), 0.0);
+        inside += usize::from(density_at(p, &f, &D, true, 0.0) > 0.0);
     }
     assert!(
         inside > 200,
@@ -75,7 +75,7 @@ fn cloud_base_is_flat() {
         );
         let onset = (0..2000)
             .map(|k| D.band_bottom_m + k as f32)
-            .find(|&y| density_at(Vec3::new(x, y, z), &f, &D, true) > 0.0);
+            .find(|&y| density_at(Vec3::new(x, y, z), &f, &D, true, 0.0) > 0.0);
         if let Some(y) = onset {
             onsets.push(y);
         }
@@ -98,7 +98,7 @@ fn cloud_top_rises_with_the_parcel_height_channel() {
             cloud_map: &cm,
         };
         (0..400)
-            .map(|i| footprint((i % 20) as f32 / 20.0, (i / 20) as f32 / 20.0, &f, &D).1)
+            .map(|i| footprint((i % 20) as f32 / 20.0, (i / 20) as f32 / 20.0, 0.0, &f, &D).1)
             .fold(0.0, f32::max)
     };
     let (low, mid, high) = (top_of(0.1), top_of(0.5), top_of(1.0));
@@ -145,7 +145,7 @@ fn transmittance_is_in_unit_range_and_monotone_along_a_ray() {
     // transmittance of what is left only grows.
     for k in 0..50 {
         let start = Vec3::new(1234.0, 500.0, 777.0) + sun * (k as f32 * 40.0);
-        let t = sun_transmittance(start, sun, 64, &f, &D);
+        let t = sun_transmittance(start, sun, 64, 0.0, &f, &D);
         assert!((0.0..=1.0).contains(&t));
         if k > 0 {
             assert!(t >= prev - 1e-6, "step {k}: {t} < {prev}");
@@ -183,7 +183,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
         (0..100)
             .map(|k| {
                 let y = d.band_bottom_m + (k as f32 + 0.5) * 10.0;
-                density_at(Vec3::new(x, y, z), &fields, &d, true) * 10.0
+                density_at(Vec3::new(x, y, z), &fields, &d, true, 0.0) * 10.0
             })
             .sum()
     };
@@ -210,6 +210,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
                 &fields,
                 &d,
                 true,
+                0.0,
             ) as f64
                 * dy as f64
         })
@@ -237,7 +238,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
         },
         terrain: None,
     };
-    let s = march_ray(origin, Vec3::Y, 0.5, &frame);
+    let s = march_ray(origin, Vec3::Y, 0.5, 0.0, &frame);
     let expected = (-tau).exp() as f32;
     assert!(
         (s.transmittance - expected).abs() / expected < BEER_LAMBERT_TOLERANCE,

@@ -39,6 +39,10 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("sphere_density", "baseline renderer, GPU only"),
     ("sphere_optical_depth", "baseline renderer, GPU only"),
     ("sphere_span", "baseline renderer, GPU only"),
+    ("sphere_hash", "baseline renderer, GPU only"),
+    ("sphere_dither", "baseline renderer, GPU only"),
+    ("sphere_value_noise", "baseline renderer, GPU only"),
+    ("sphere_noise", "baseline renderer, GPU only"),
 ];
 
 /// Every WGSL constant and its Rust twin's value.
@@ -54,6 +58,13 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("WARP_RAMP_OUTER", density::WARP_RAMP.1 as f64),
         ("WEATHER_SCALE_M", density::WEATHER_SCALE_M as f64),
         ("REFINE", renderer::REFINE as f64),
+        ("NEAR_M", renderer::NEAR_M as f64),
+        ("DETAIL_TILE", density::DETAIL_TILE as f64),
+        ("BILLOW_FREQUENCY", density::BILLOW_FREQUENCY as f64),
+        ("BASE_WEIGHT", density::BASE_WEIGHT as f64),
+        ("NOISE_MAX_LOD", density::NOISE_MAX_LOD as f64),
+        ("NOISE_SIZE", cumulus::render::noise_volume::SIZE as f64),
+        ("BLUE_NOISE_SIZE", cumulus::render::sampling::SIZE as f64),
         ("ALBEDO", renderer::ALBEDO as f64),
         ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE as f64),
         ("SUN_DISK_COS", sky::SUN_DISK_COS as f64),

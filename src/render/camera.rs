@@ -260,6 +260,17 @@ impl View {
         self.ray_ndc(pixel_ndc(x, y, width, height))
     }
 
+    /// The angle (radians) between the rays through the centre pixel of a
+    /// `width x height` image and its neighbour below: a pixel's cone, so
+    /// that a point at distance `t` is seen over a footprint `t` times
+    /// this wide (the level of detail of texture lookups).
+    pub fn pixel_spread(&self, width: u32, height: u32) -> f32 {
+        let (cx, cy) = (0.5 * width.max(1) as f32, 0.5 * height.max(1) as f32);
+        let a = self.camera_ray(cx, cy, width, height);
+        let b = self.camera_ray(cx, cy + 1.0, width, height);
+        a.dot(b).clamp(-1.0, 1.0).acos()
+    }
+
     /// Distance from the eye to the surface a depth buffer holds `depth`
     /// for at pixel `(x, y)`, m: infinite for a far-plane depth at
     /// infinity; `depth_to_distance` in WGSL.

@@ -82,7 +82,7 @@ impl CoverageMask {
 mod tests {
     use super::*;
     use crate::render::cloud_map::{CloudMap, CloudMapConfig};
-    use crate::render::cpu::density::{DensityParams, Fields, density_at, hash3, warped_lookup};
+    use crate::render::cpu::density::{DensityParams, Fields, density_at, warped_lookup};
     use glam::Vec3;
 
     /// Wherever the mask is clear, the CPU density is zero: the GPU's early
@@ -122,9 +122,13 @@ mod tests {
         };
         let (mut clear, mut dense) = (0, 0);
         for i in 0..40_000 {
-            let r = |k: i32| hash3(i, k, 7);
+            let r = |k: u32| {
+                let h = (i as u32).wrapping_mul(0x9e37_79b9) ^ k.wrapping_mul(0x85eb_ca6b);
+                let h = (h ^ (h >> 15)).wrapping_mul(0x2c1b_3c6d);
+                ((h ^ (h >> 12)) >> 8) as f32 / 16_777_216.0
+            };
             let q = Vec3::new(r(1) * 10_000.0, 600.0 + r(2) * 1000.0, r(3) * 10_000.0);
-            let sigma = density_at(q, &f, &d, true);
+            let sigma = density_at(q, &f, &d, true, (i % 7) as f32 * 20.0);
             dense += (sigma > 0.0) as u32;
             // The density looks P up through the domain warp.
             let (u, v, _) = warped_lookup(q.x, q.z, d.map_extent_m);

@@ -8,5 +8,7 @@ pub mod cloud_map;
 pub mod coverage_mask;
 pub mod cpu;
 pub mod gpu;
+pub mod noise_volume;
+pub mod sampling;
 pub mod soft_field;
 pub mod terrain;

@@ -131,10 +131,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
             .with_context(|| format!("{}: cannot create directory", dir.display()))?;
         guard_output_dir(dir);
         let (w, h) = (r.width.min(320), r.height.min(240));
-        let bar = progress_bar(render_quality::STEPS.len() as u64 + 1, "rendering");
+        let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");
         let report = render_quality::measure(&frame, w, h, &render_quality::STEPS, || bar.inc(1));
+        let (hw, hh) = (w.min(160), h.min(120));
+        let hp = render_quality::measure_highpass(&frame, hw, hh);
         bar.finish_and_clear();
         render_quality::write(&report, dir)?;
+        render_quality::write_highpass(&hp, dir)?;
         println!(
             "reference ({} steps) took {:.2} s at {w}x{h}",
             render_quality::REFERENCE_STEPS,
@@ -162,7 +165,17 @@ pub fn run(a: RenderArgs) -> Result<()> {
             ),
         }
         println!(
-            "wrote {0}/render_quality.csv and {0}/render_quality.png",
+            "high-pass energy of {} cloud pixels at {hw}x{hh}, against {} steps x {} frames: \
+             one frame {:.2}x, {} frames averaged (TSAA) {:.2}x",
+            hp.cloud_pixels,
+            render_quality::HIGHPASS_REFERENCE_STEPS,
+            cumulus::render::sampling::JITTER_CYCLE,
+            hp.one_frame_ratio(),
+            cumulus::render::sampling::JITTER_CYCLE,
+            hp.converged_ratio()
+        );
+        println!(
+            "wrote {0}/render_quality.csv, {0}/render_quality.png and {0}/highpass.csv",
             dir.display()
         );
     }

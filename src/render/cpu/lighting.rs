@@ -27,9 +27,17 @@ pub const SHADOW_RAY_M: f32 = 2000.0;
 /// Optical depth (dimensionless) from `p` toward the sun through the band,
 /// by `steps` samples with growing step lengths (1, 2, 3, ... parts) over
 /// at most [`SHADOW_RAY_M`]. The detail noise is left out of shadow rays: it changes
-/// the light little and would triple their cost.
+/// the light little and would triple their cost. The map is read at the
+/// level of detail of `footprint_m`, the primary sample's.
 #[inline]
-pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
+pub fn sun_optical_depth(
+    p: Vec3,
+    sun_dir: Vec3,
+    steps: u32,
+    footprint_m: f32,
+    f: &Fields,
+    d: &DensityParams,
+) -> f32 {
     if steps == 0 {
         return 0.0;
     }
@@ -48,7 +56,7 @@ pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &Den
         if height_fraction(q.y, d) > 1.0 {
             break;
         }
-        tau += density_at(q, f, d, false) * dt;
+        tau += density_at(q, f, d, false, footprint_m) * dt;
         t += dt;
     }
     tau
@@ -56,8 +64,15 @@ pub fn sun_optical_depth(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &Den
 
 /// Transmittance toward the sun, in `[0, 1]`.
 #[inline]
-pub fn sun_transmittance(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
-    (-sun_optical_depth(p, sun_dir, steps, f, d)).exp()
+pub fn sun_transmittance(
+    p: Vec3,
+    sun_dir: Vec3,
+    steps: u32,
+    footprint_m: f32,
+    f: &Fields,
+    d: &DensityParams,
+) -> f32 {
+    (-sun_optical_depth(p, sun_dir, steps, footprint_m, f, d)).exp()
 }
 
 /// Sun light scattered toward the eye per unit scattering coefficient, with

@@ -1,5 +1,7 @@
 //! The CPU reference renderer: per pixel (rayon over rows), deterministic
-//! (ray starts at pixel centres, no jitter), any step count.
+//! (one frame: rays through pixel centres, each pixel's blue-noise dither),
+//! any step count; and the converged oracle that averages the very frames
+//! the GPU's TSAA accumulates (`render_converged`).
 
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -8,6 +10,7 @@ use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
 use super::sky::{sky_radiance, sun_color, sun_direction, sun_disk};
 use crate::render::camera::View;
+use crate::render::sampling::{self, frame_offset, jitter};
 use crate::render::terrain::Heightfield;
 
 /// Quality and look (scene table `[render]` keys that are not camera,
@@ -60,13 +63,29 @@ pub struct RaySample {
     pub transmittance: f32,
 }
 
-/// Interleaved gradient noise (Jimenez 2014) in `[0, 1)`: a fixed
-/// per-pixel offset of the first march sample that turns step banding into
-/// fine noise. Deterministic: the same pixel always gets the same offset.
+/// The pixel's offset of its march samples within their steps, in `(0,
+/// 1)`: the blue-noise tile (`render::sampling`), which turns step banding
+/// into fine grain without the checker and moire of a structured pattern.
+/// Each frame adds its golden-ratio offset (`sampling::frame_offset`).
 #[inline]
 pub fn pixel_dither(x: u32, y: u32) -> f32 {
-    let f = |v: f32| v - v.floor();
-    f(52.982_918 * f(0.067_110_56 * x as f32 + 0.005_837_15 * y as f32))
+    sampling::at(x, y)
+}
+
+/// Distance scale of the march's step growth, m: coarse steps are
+/// uniform in `ln(t + NEAR_M)`, so a step is about `(t + NEAR_M) / steps
+/// · ln((t1 + NEAR_M) / (t0 + NEAR_M))` long: short near the camera, where
+/// a pixel covers little and clouds are large on screen, long far away
+/// (looking down on the band, `t1 / t0` is near 1 and the steps are
+/// uniform). 3 km: along a horizontal ray through a 50 km band the first
+/// of 48 steps is 180 m and the last 3.2 km (uniform: 1 km each).
+pub const NEAR_M: f32 = 3000.0;
+
+/// The distance at march parameter `s` (0 at `t0`, 1 at the segment's far
+/// end, `log_ratio = ln((t1 + NEAR_M) / (t0 + NEAR_M))`).
+#[inline]
+pub fn march_distance(t0: f32, log_ratio: f32, s: f32) -> f32 {
+    (t0 + NEAR_M) * (s * log_ratio).exp() - NEAR_M
 }
 
 /// Sub-samples of a coarse march interval that touches cloud.
@@ -77,8 +96,11 @@ pub const REFINE: u32 = 4;
 pub const SUN_INTENSITY: f32 = 8.0;
 
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
-/// in `[0, 1)` places the samples within their steps (0.5: centres).
-pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample {
+/// in `[0, 1)` places the samples within their steps (0.5: centres);
+/// `spread` is the pixel's cone angle (radians, [`View::pixel_spread`]):
+/// a sample at distance `t` reads the textures at the level of detail of
+/// a footprint `spread · t` wide.
+pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) -> RaySample {
     let d = &fr.density;
     let q = &fr.quality;
     let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
@@ -103,7 +125,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
         };
     };
     let steps = q.steps.max(1);
-    let dt = (t1 - t0) / steps as f32;
+    let log_ratio = ((t1 + NEAR_M) / (t0 + NEAR_M)).ln();
     let sun = sun_color(sun_dir) * SUN_INTENSITY;
     // Irradiance from the upper sky (π L), scattered isotropically (1/4π).
     let ambient_top = sky_radiance(Vec3::Y, sun_dir) * 0.25;
@@ -111,29 +133,34 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, fr: &Frame) -> RaySample 
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
     let mut depth_weighted = 0.0_f32;
-    // Coarse intervals of `dt`; an interval whose ends touch cloud is
-    // sampled REFINE times finer (the dither places the samples), so thin
-    // cloud edges seen at grazing angles get several samples, and empty sky
-    // costs one density lookup per interval.
-    let mut sigma_a = density_at(origin + dir * t0, &fr.fields, d, true);
+    // Coarse intervals growing with distance ([`march_distance`]); an
+    // interval whose ends touch cloud is sampled REFINE times finer (the
+    // dither places the samples), so thin cloud edges seen at grazing
+    // angles get several samples, and empty sky costs one density lookup
+    // per interval.
+    let mut sigma_a = density_at(origin + dir * t0, &fr.fields, d, true, spread * t0);
+    let mut ta = t0;
     'march: for i in 0..steps {
-        let ta = t0 + i as f32 * dt;
-        let sigma_b = density_at(origin + dir * (ta + dt), &fr.fields, d, true);
+        let tb = march_distance(t0, log_ratio, (i + 1) as f32 / steps as f32);
+        let sigma_b = density_at(origin + dir * tb, &fr.fields, d, true, spread * tb);
         let touched = sigma_a > 0.0 || sigma_b > 0.0;
         sigma_a = sigma_b;
         let (n, h) = if touched {
-            (REFINE, dt / REFINE as f32)
+            (REFINE, (tb - ta) / REFINE as f32)
         } else {
-            (1, dt)
+            (1, tb - ta)
         };
+        let start = ta;
+        ta = tb;
         for j in 0..n {
-            let t = ta + (j as f32 + dither) * h;
+            let t = start + (j as f32 + dither) * h;
             let p = origin + dir * t;
-            let sigma_t = density_at(p, &fr.fields, d, true);
+            let footprint = spread * t;
+            let sigma_t = density_at(p, &fr.fields, d, true, footprint);
             if sigma_t <= 0.0 {
                 continue;
             }
-            let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, &fr.fields, d);
+            let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, footprint, &fr.fields, d);
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
             // Sky light from above, darker toward the cloud base.
             let ambient = ambient_top * (0.35 + 0.65 * eta);
@@ -207,66 +234,76 @@ pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityP
     };
     let dt = (t1 - t0) / steps.max(1) as f32;
     let tau: f32 = (0..steps.max(1))
-        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d, false) * dt)
+        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d, false, 0.0) * dt)
         .sum();
     (-tau).exp()
 }
 
 /// Renders a `width x height` image of linear radiance, row-major, each
-/// pixel the mean of `offsets` marches whose samples are shifted by `k /
-/// offsets` of a step from the pixel's dither (`k = 0..offsets`): the
-/// fixed per-pixel dither's pattern (a fine checker and moire on cloud
-/// surfaces at 48 steps) averages out, as the GPU's TSAA averages its
-/// per-frame offsets. `offsets = 1` is [`render_linear`].
+/// pixel the mean of `offsets` marches through its centre whose samples
+/// are shifted from the pixel's dither by the first `offsets` frames'
+/// golden-ratio offsets ([`frame_offset`]): the dither's grain averages
+/// out, as the GPU's TSAA averages its per-frame offsets. `offsets = 1`
+/// is [`render_linear`].
 pub fn render_linear_offsets(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec3> {
-    render_marches(width, height, fr, offsets, |s| s.radiance.extend(0.0))
+    render_marches(width, height, fr, offsets, false, |s| {
+        s.radiance.extend(0.0)
+    })
+    .into_iter()
+    .map(Vec4::truncate)
+    .collect()
+}
+
+/// The converged oracle: each pixel the mean of the `frames` marches the
+/// GPU's TSAA accumulates with a static camera (frame `k`'s sub-pixel
+/// jitter and dither offset, [`jitter`]); with more steps than the GPU's
+/// (the caller's `fr`), the clean image the GPU's converged frames are
+/// measured against. `frames` is best a multiple of
+/// [`sampling::JITTER_CYCLE`].
+pub fn render_converged(width: u32, height: u32, fr: &Frame, frames: u32) -> Vec<Vec3> {
+    render_marches(width, height, fr, frames, true, |s| s.radiance.extend(0.0))
         .into_iter()
         .map(Vec4::truncate)
         .collect()
 }
 
-/// Per pixel (rayon over rows, row-major) the mean over `offsets` shifted
-/// marches of `pick` of the ray's sample.
+/// Per pixel (rayon over rows, row-major) the mean over `frames` marches
+/// of `pick` of the ray's sample: through the pixel's centre with frame
+/// `k`'s dither offset, or (`jittered`) also with its sub-pixel jitter.
 fn render_marches(
     width: u32,
     height: u32,
     fr: &Frame,
-    offsets: u32,
+    frames: u32,
+    jittered: bool,
     pick: impl Fn(RaySample) -> Vec4 + Sync,
 ) -> Vec<Vec4> {
-    let n = offsets.max(1);
+    let n = frames.max(1);
     let w = width as usize;
+    let spread = fr.view.pixel_spread(width, height);
     let mut out = vec![Vec4::ZERO; w * height as usize];
     out.par_chunks_mut(w.max(1))
         .enumerate()
         .for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
-                *px = mean_march(x as u32, y as u32, width, height, fr, n, &pick);
+                let d0 = pixel_dither(x as u32, y as u32);
+                let mut sum = Vec4::ZERO;
+                for k in 0..n {
+                    let [jx, jy, offset] = if jittered {
+                        jitter(k)
+                    } else {
+                        [0.0, 0.0, frame_offset(k)]
+                    };
+                    let dir =
+                        fr.view
+                            .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);
+                    let d = (d0 + offset).fract();
+                    sum += pick(march_ray(fr.view.eye(), dir, d, spread, fr));
+                }
+                *px = sum / n as f32;
             }
         });
     out
-}
-
-/// The mean of `pick` over `n` shifted marches of pixel `(x, y)`.
-fn mean_march(
-    x: u32,
-    y: u32,
-    width: u32,
-    height: u32,
-    fr: &Frame,
-    n: u32,
-    pick: &impl Fn(RaySample) -> Vec4,
-) -> Vec4 {
-    let dir = fr
-        .view
-        .camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
-    let d0 = pixel_dither(x, y);
-    let mut sum = Vec4::ZERO;
-    for k in 0..n {
-        let d = (d0 + k as f32 / n as f32).fract();
-        sum += pick(march_ray(fr.view.eye(), dir, d, fr));
-    }
-    sum / n as f32
 }
 
 /// The clouds alone, without the sky or terrain behind them: per pixel
@@ -281,7 +318,7 @@ pub fn render_clouds_linear(width: u32, height: u32, fr: &Frame, offsets: u32) -
         terrain: None,
         ..*fr
     };
-    render_marches(width, height, fr, offsets, |s| {
+    render_marches(width, height, fr, offsets, false, |s| {
         s.clouds.extend(1.0 - s.transmittance)
     })
 }
@@ -289,8 +326,9 @@ pub fn render_clouds_linear(width: u32, height: u32, fr: &Frame, offsets: u32) -
 /// Renders a `width x height` image of linear radiance, row-major, each
 /// pixel one march with its fixed dither (the GPU's twin without TSAA).
 pub fn render_linear(width: u32, height: u32, fr: &Frame) -> Vec<Vec3> {
-    // One offset: the dither itself (fract of a value in [0, 1) is itself,
-    // and a sum of one divided by one is exact).
+    // One offset: the dither itself (frame 0's offset is 0, the fract of
+    // a value in [0, 1) is itself, and a sum of one divided by one is
+    // exact).
     render_linear_offsets(width, height, fr, 1)
 }
 
@@ -332,4 +370,37 @@ pub fn to_srgb8(linear: &[Vec3], exposure: f32) -> Vec<u8> {
         .iter()
         .flat_map(|c| [enc(c.x), enc(c.y), enc(c.z)])
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The coarse steps span the segment exactly, grow with distance along
+    /// a long horizontal ray, and are uniform looking down on the band.
+    #[test]
+    fn march_steps_span_the_segment_and_grow_with_distance() {
+        for (t0, t1) in [
+            (0.0_f32, 50_000.0_f32),
+            (7_500.0, 9_000.0),
+            (120.0, 4_000.0),
+        ] {
+            let lr = ((t1 + NEAR_M) / (t0 + NEAR_M)).ln();
+            assert!((march_distance(t0, lr, 0.0) - t0).abs() < 1e-3);
+            assert!((march_distance(t0, lr, 1.0) - t1).abs() < 1e-3 * t1.max(1.0));
+            let step = |i: u32| {
+                march_distance(t0, lr, (i + 1) as f32 / 48.0)
+                    - march_distance(t0, lr, i as f32 / 48.0)
+            };
+            let (first, last) = (step(0), step(47));
+            assert!(first > 0.0 && last >= first, "{first} {last}");
+            if t0 == 0.0 {
+                // 50 km from inside the band: 180 m near, 3.2 km far.
+                assert!((150.0..220.0).contains(&first) && (2_900.0..3_500.0).contains(&last));
+            }
+            if t0 == 7_500.0 {
+                assert!(last / first < 1.2, "{first} {last}");
+            }
+        }
+    }
 }

@@ -165,6 +165,7 @@ impl BaselineRenderer {
             terrain: [0.0; 2],
             p_size: [1, 1],
             mask: [1, 1, 1, 0],
+            map_size: 1,
         });
         self.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));

@@ -34,6 +34,21 @@ pub fn texture_entry(
     )
 }
 
+/// A 3D texture binding.
+pub fn texture_3d_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
+    entry(
+        binding,
+        wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+    )
+}
+
 /// A filtering sampler binding.
 pub fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     entry(

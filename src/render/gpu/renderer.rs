@@ -145,7 +145,7 @@ impl CloudRenderer {
         cloud_map: &CloudMap,
         terrain: Option<&Heightfield>,
     ) -> Self {
-        let inputs = Inputs::new(device, queue, cloud_map);
+        let inputs = Inputs::new(device, queue, cloud_map, settings.detail());
         let constants = settings.constants();
         let size = (0, 0);
         Self {
@@ -222,6 +222,9 @@ impl CloudRenderer {
         } else if let (Some(t), Some(s)) = (&mut self.tsaa, settings.tsaa) {
             t.settings = s;
         }
+        let queue = self.queue.clone();
+        self.inputs
+            .set_detail(&self.device, &queue, settings.detail());
         if constants_changed && let Some(t) = &mut self.terrain {
             t.rebuild_pipeline(&self.device, &self.inputs.layout, &constants);
         }
@@ -321,9 +324,13 @@ impl CloudRenderer {
         let mut v = vec![
             "clouds.P",
             "clouds.cloud_map",
+            "clouds.blue_noise",
             "clouds.coverage_mask",
             "clouds.layer",
         ];
+        if self.inputs.detail {
+            v.push("clouds.detail_volume");
+        }
         if self.tsaa.is_some() {
             v.extend(["clouds.distance", "tsaa.history0", "tsaa.history1"]);
         }
@@ -561,6 +568,7 @@ impl CloudRenderer {
             terrain,
             p_size: self.inputs.p_size,
             mask: self.inputs.mask_info,
+            map_size: self.inputs.map_size,
         });
         self.queue
             .write_buffer(&self.inputs.uniforms, 0, bytemuck::bytes_of(&u));

@@ -22,6 +22,12 @@ pub struct GpuSettings {
 }
 
 impl GpuSettings {
+    /// Whether the 3D detail noise is on (its volume is uploaded and its
+    /// reads compiled in).
+    pub fn detail(&self) -> bool {
+        self.density.detail_strength > 0.0
+    }
+
     /// Values of the WGSL `override` constants (`shaders/clouds.wgsl`) for
     /// these settings: a feature that is off is compiled out.
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
@@ -29,7 +35,7 @@ impl GpuSettings {
         vec![
             ("SHADOW_STEPS", self.quality.shadow_steps as f64),
             ("OCTAVES", self.quality.octaves as f64),
-            ("DETAIL", flag(self.density.detail_strength > 0.0)),
+            ("DETAIL", flag(self.detail())),
             ("DEBUG_COUNT", flag(self.debug_sample_count)),
         ]
     }

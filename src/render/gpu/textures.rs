@@ -1,10 +1,13 @@
-//! Texture helpers: creation with labels, uploads of P, the cloud map, the
-//! coverage mask and the heightfield.
+//! Texture helpers: creation with labels, uploads of P, the cloud map (with
+//! its mip chain), the 3D detail volume (with its mips), the blue-noise
+//! tile, the coverage mask and the heightfield.
 
 use half::f16;
 
 use crate::render::cloud_map::CloudMap;
 use crate::render::coverage_mask::CoverageMask;
+use crate::render::noise_volume::{NoiseVolume, SIZE as NOISE_SIZE};
+use crate::render::sampling;
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
 
@@ -51,11 +54,22 @@ pub fn create_2d(
 
 /// Writes `data` (tightly packed rows of `bytes_per_texel`) to all of `texture`.
 pub fn write_all(queue: &wgpu::Queue, texture: &wgpu::Texture, data: &[u8], bytes_per_texel: u32) {
-    let size = texture.size();
+    write_level(queue, texture, 0, data, bytes_per_texel);
+}
+
+/// Writes `data` (tightly packed) to all of mip level `level` of `texture`.
+fn write_level(
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    level: u32,
+    data: &[u8],
+    bytes_per_texel: u32,
+) {
+    let size = texture.size().mip_level_size(level, texture.dimension());
     queue.write_texture(
         wgpu::TexelCopyTextureInfo {
             texture,
-            mip_level: 0,
+            mip_level: level,
             origin: wgpu::Origin3d::ZERO,
             aspect: wgpu::TextureAspect::All,
         },
@@ -69,6 +83,98 @@ pub fn write_all(queue: &wgpu::Queue, texture: &wgpu::Texture, data: &[u8], byte
     );
 }
 
+/// Uploads the cloud map and its mip chain (`FIELD_FORMAT`): the GPU
+/// samples the levels the CPU twin computed, not ones it filters itself.
+pub fn upload_cloud_map(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    cm: &CloudMap,
+) -> wgpu::Texture {
+    let n = cm.size() as u32;
+    let t = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("clouds.cloud_map"),
+        size: wgpu::Extent3d {
+            width: n,
+            height: n,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: cm.levels() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: FIELD_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for k in 0..cm.levels() {
+        let (_, texels) = cm.level(k);
+        let h = halves(texels.iter().map(|&[a, b]| [a, b, 0.0, 0.0]));
+        write_level(queue, &t, k as u32, bytemuck::cast_slice(&h), 8);
+    }
+    t
+}
+
+/// Uploads the 3D detail volume and its mips (`Rg8Unorm`, filterable),
+/// or, without `v` (the detail is off), a 1³ stand-in that no shader
+/// variant reads, so the binding exists but the volume does not.
+pub fn upload_noise_volume(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    v: Option<&NoiseVolume>,
+) -> wgpu::Texture {
+    let Some(v) = v else {
+        let t = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("clouds.detail_volume_off"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::Rg8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        write_level(queue, &t, 0, &[128, 128], 2);
+        return t;
+    };
+    let n = NOISE_SIZE as u32;
+    let t = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("clouds.detail_volume"),
+        size: wgpu::Extent3d {
+            width: n,
+            height: n,
+            depth_or_array_layers: n,
+        },
+        mip_level_count: v.level_count() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: wgpu::TextureFormat::Rg8Unorm,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for k in 0..v.level_count() {
+        write_level(queue, &t, k as u32, bytemuck::cast_slice(v.level(k)), 2);
+    }
+    t
+}
+
+/// Uploads the blue-noise tile (`R32Float`, read with `textureLoad`).
+pub fn upload_blue_noise(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
+    let n = sampling::SIZE as u32;
+    let t = create_2d(
+        device,
+        "clouds.blue_noise",
+        n,
+        n,
+        wgpu::TextureFormat::R32Float,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    );
+    write_all(queue, &t, bytemuck::cast_slice(sampling::tile()), 4);
+    t
+}
+
 fn halves(texels: impl Iterator<Item = [f32; 4]>) -> Vec<f16> {
     texels.flat_map(|t| t.map(f16::from_f32)).collect()
 }
@@ -76,15 +182,6 @@ fn halves(texels: impl Iterator<Item = [f32; 4]>) -> Vec<f16> {
 /// P as `FIELD_FORMAT` texels.
 pub fn field_texels(p: &ProjectedField) -> Vec<f16> {
     halves(p.texels().iter().map(|t| [t[0], t[1], t[2], 0.0]))
-}
-
-/// The cloud map as `FIELD_FORMAT` texels.
-pub fn cloud_map_texels(cm: &CloudMap) -> Vec<f16> {
-    let n = cm.size();
-    halves((0..n * n).map(|k| {
-        let [a, b] = cm.texel(k % n, k / n);
-        [a, b, 0.0, 0.0]
-    }))
 }
 
 /// Uploads a texture of `FIELD_FORMAT` from `texels` (`width x height`).

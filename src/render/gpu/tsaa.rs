@@ -1,6 +1,6 @@
-//! Temporal anti-aliasing: the jitter sequence, the camera-cut rule, and
+//! Temporal anti-aliasing: the camera-cut rule and
 //! the `tsaa` pass with its ping-pong history (the shader is
-//! `shaders/tsaa.wgsl`).
+//! `shaders/tsaa.wgsl`); the jitter sequence is `render::sampling`'s.
 
 use super::bind::{self, FILTERABLE, Recorder, UNFILTERABLE};
 use super::inputs::Inputs;
@@ -11,27 +11,7 @@ use crate::render::camera::View;
 /// The pass's name.
 pub const PASS_TSAA: &str = "tsaa";
 
-/// The radical inverse of `index` in `base` (Halton 1964), in `[0, 1)`.
-pub fn halton(mut index: u32, base: u32) -> f32 {
-    let (mut f, mut r) = (1.0_f32, 0.0_f32);
-    while index > 0 {
-        f /= base as f32;
-        r += f * (index % base) as f32;
-        index /= base;
-    }
-    r
-}
-
-/// Frames in the jitter cycle.
-pub const JITTER_CYCLE: u32 = 16;
-
-/// The jitter of frame `n`: a sub-pixel ray offset in `[-0.5, 0.5)²` pixels
-/// from Halton(2, 3), and a march-dither offset in `[0, 1)` from Halton(5),
-/// cycling every [`JITTER_CYCLE`] frames.
-pub fn jitter(n: u32) -> [f32; 3] {
-    let i = n % JITTER_CYCLE + 1;
-    [halton(i, 2) - 0.5, halton(i, 3) - 0.5, halton(i, 5)]
-}
+pub use crate::render::sampling::{JITTER_CYCLE, halton, jitter};
 
 /// The camera moved so far in one frame that the history is useless: more
 /// than [`CUT_DISTANCE_M`] or turned by more than [`CUT_ANGLE_DEG`], or the

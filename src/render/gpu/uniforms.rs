@@ -60,6 +60,8 @@ pub struct FrameInputs {
     pub p_size: [u32; 2],
     /// Coverage mask: width, height, P texels per mask cell, 0.
     pub mask: [u32; 4],
+    /// Texels per side of the cloud map.
+    pub map_size: u32,
 }
 
 impl FrameUniforms {
@@ -75,7 +77,7 @@ impl FrameUniforms {
         let d = &i.density;
         let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
         Self {
-            cam_pos: v4(i.view.eye(), 0.0),
+            cam_pos: v4(i.view.eye(), i.view.pixel_spread(i.width, i.height)),
             screen: [
                 w,
                 h,
@@ -92,7 +94,12 @@ impl FrameUniforms {
                 d.coverage,
                 d.extinction_per_m,
             ],
-            map: [d.map_extent_m, d.detail_strength, d.detail_scale_m, 0.0],
+            map: [
+                d.map_extent_m,
+                d.detail_strength,
+                d.detail_scale_m,
+                d.map_extent_m / i.map_size.max(1) as f32,
+            ],
             jitter: [i.jitter[0], i.jitter[1], i.jitter[2], i.blend],
             terrain: [i.terrain[0], i.terrain[1], 0.0, 0.0],
             counts: [q.steps.max(1), i.p_size[0], i.p_size[1], i.frame_index],

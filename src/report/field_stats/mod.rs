@@ -173,6 +173,9 @@ pub fn column_field_over(
     let cell = span_m / n as f64;
     let levels = levels.max(1);
     let dz = (d.band_top_m - d.band_bottom_m) / levels as f32;
+    // The textures are read at the level of detail of a column's width,
+    // as a renderer looking down at this resolution reads them.
+    let footprint_m = cell as f32;
     let rows: Vec<(Vec<f64>, Vec<u32>)> = (0..n)
         .into_par_iter()
         .map(|j| {
@@ -185,7 +188,13 @@ pub fn column_field_over(
                 );
                 for (k, c) in cloudy.iter_mut().enumerate() {
                     let y = d.band_bottom_m + (k as f32 + 0.5) * dz;
-                    let sigma = density_at(glam::Vec3::new(x, y, z), &frame.fields, d, true);
+                    let sigma = density_at(
+                        glam::Vec3::new(x, y, z),
+                        &frame.fields,
+                        d,
+                        true,
+                        footprint_m,
+                    );
                     if sigma > 0.0 {
                         *t += (sigma * dz) as f64;
                         *c += 1;
