@@ -19,19 +19,27 @@ fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-/// A 2D texture binding.
-pub fn texture_entry(
+fn texture_of(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
 ) -> wgpu::BindGroupLayoutEntry {
     entry(
         binding,
         wgpu::BindingType::Texture {
             sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
+            view_dimension,
             multisampled: false,
         },
     )
+}
+
+/// A 2D texture binding.
+pub fn texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
+    texture_of(binding, sample_type, wgpu::TextureViewDimension::D2)
 }
 
 /// A 3D texture binding.
@@ -39,14 +47,7 @@ pub fn texture_3d_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
 ) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D3,
-            multisampled: false,
-        },
-    )
+    texture_of(binding, sample_type, wgpu::TextureViewDimension::D3)
 }
 
 /// A filtering sampler binding.

@@ -83,6 +83,32 @@ fn write_level(
     );
 }
 
+/// A sampled texture, written by uploads, of `size` (width, height,
+/// depth) with `levels` mip levels.
+fn create_sampled(
+    device: &wgpu::Device,
+    label: &str,
+    size: [u32; 3],
+    levels: u32,
+    dimension: wgpu::TextureDimension,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size[0],
+            height: size[1],
+            depth_or_array_layers: size[2],
+        },
+        mip_level_count: levels,
+        sample_count: 1,
+        dimension,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
 /// Uploads the cloud map and its mip chain (`FIELD_FORMAT`): the GPU
 /// samples the levels the CPU twin computed, not ones it filters itself.
 pub fn upload_cloud_map(
@@ -91,20 +117,14 @@ pub fn upload_cloud_map(
     cm: &CloudMap,
 ) -> wgpu::Texture {
     let n = cm.size() as u32;
-    let t = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("clouds.cloud_map"),
-        size: wgpu::Extent3d {
-            width: n,
-            height: n,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: cm.levels() as u32,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: FIELD_FORMAT,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let t = create_sampled(
+        device,
+        "clouds.cloud_map",
+        [n, n, 1],
+        cm.levels() as u32,
+        wgpu::TextureDimension::D2,
+        FIELD_FORMAT,
+    );
     for k in 0..cm.levels() {
         let (_, texels) = cm.level(k);
         let h = halves(texels.iter().map(|&[a, b]| [a, b, 0.0, 0.0]));
@@ -121,39 +141,26 @@ pub fn upload_noise_volume(
     queue: &wgpu::Queue,
     v: Option<&NoiseVolume>,
 ) -> wgpu::Texture {
+    let volume = |label: &str, n: u32, levels: u32| {
+        create_sampled(
+            device,
+            label,
+            [n, n, n],
+            levels,
+            wgpu::TextureDimension::D3,
+            wgpu::TextureFormat::Rg8Unorm,
+        )
+    };
     let Some(v) = v else {
-        let t = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("clouds.detail_volume_off"),
-            size: wgpu::Extent3d {
-                width: 1,
-                height: 1,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: wgpu::TextureFormat::Rg8Unorm,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let t = volume("clouds.detail_volume_off", 1, 1);
         write_level(queue, &t, 0, &[128, 128], 2);
         return t;
     };
-    let n = NOISE_SIZE as u32;
-    let t = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("clouds.detail_volume"),
-        size: wgpu::Extent3d {
-            width: n,
-            height: n,
-            depth_or_array_layers: n,
-        },
-        mip_level_count: v.level_count() as u32,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D3,
-        format: wgpu::TextureFormat::Rg8Unorm,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let t = volume(
+        "clouds.detail_volume",
+        NOISE_SIZE as u32,
+        v.level_count() as u32,
+    );
     for k in 0..v.level_count() {
         write_level(queue, &t, k as u32, bytemuck::cast_slice(v.level(k)), 2);
     }
