@@ -18,10 +18,11 @@ override DEBUG_COUNT: bool = false;
 
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
+const EROSION_BASE: f32 = 0.6;
 const SURFACE_RAMP: f32 = 0.08;
 const DETAIL_CONTRAST: f32 = 1.23;
 const WARP_SCALE_M: f32 = 9000.0;
-const WARP_AMPLITUDE_M: f32 = 1700.0;
+const WARP_AMPLITUDE_M: f32 = 2000.0;
 const WARP_RAMP_INNER: f32 = 0.72;
 const WARP_RAMP_OUTER: f32 = 1.3;
 const WEATHER_SCALE_M: f32 = 3000.0;
@@ -233,6 +234,12 @@ fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
     return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0);
 }
 
+// The detail noise's weight, growing with height (the CPU's
+// `erosion_strength`).
+fn erosion_strength(s: f32, eta: f32, top: f32) -> f32 {
+    return s * (EROSION_BASE + (1.0 - EROSION_BASE) * clamp(eta / top, 0.0, 1.0));
+}
+
 // The map value and the 3D noise mixed by `s`, the noise's contrast
 // widened, the mix's spread restored (the CPU's `cloud_field`).
 fn cloud_field(m: f32, n: f32, s: f32) -> f32 {
@@ -287,7 +294,7 @@ fn density_at(p: vec3f, detail: bool, footprint_m: f32) -> f32 {
         return 0.0;
     }
     let threshold = cumulus_threshold(eta, fp.y, fp.x);
-    let s = frame.map.y;
+    let s = erosion_strength(frame.map.y, eta, fp.y);
     if cloud_field(fp.w, 1.0, s) < threshold {
         return 0.0;
     }

@@ -50,6 +50,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
     vec![
         ("PI", std::f32::consts::PI as f64),
         ("BASE_RAMP", density::BASE_RAMP as f64),
+        ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
         ("DETAIL_CONTRAST", density::DETAIL_CONTRAST as f64),
         ("WARP_SCALE_M", density::WARP_SCALE_M as f64),
