@@ -95,7 +95,7 @@ fn wrap_i(a: i32, period: i32) -> i32 {
 }
 
 fn lod_of(footprint_m: f32, texel_m: f32) -> f32 {
-    return round(max(log2(footprint_m / texel_m), 0.0));
+    return round(log2(max(footprint_m / texel_m, 1.0)));
 }
 
 // The gain restoring a mip level's spread (the CPU's `noise_gain`).

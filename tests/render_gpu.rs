@@ -266,8 +266,9 @@ fn the_same_p_costs_the_same_whatever_made_it() {
     assert_eq!(a, cloud_layer(&ctx, &hl.renderer));
 }
 
-/// The converged CPU oracle as sRGB8: the 32 jittered frames TSAA
-/// accumulates, each with 16 times the steps (192), averaged.
+/// The converged CPU oracle as sRGB8: the 16 jittered frames of TSAA's
+/// cycle (frames 16-31 repeat them), each with 16 times the steps (192),
+/// averaged.
 fn converged_reference(p: &Prepared, r: &RenderSettings, w: u32, h: u32) -> Vec<u8> {
     let mut q = r.quality();
     q.steps = 192;
@@ -276,7 +277,7 @@ fn converged_reference(p: &Prepared, r: &RenderSettings, w: u32, h: u32) -> Vec<
         height: h,
         ..r.clone()
     };
-    to_srgb8(&render_converged(w, h, &p.frame(&r, q), 32), q.exposure)
+    to_srgb8(&render_converged(w, h, &p.frame(&r, q), 16), q.exposure)
 }
 
 fn tsaa_scene() -> (Scene, Prepared) {

@@ -239,7 +239,9 @@ impl View {
     /// projection).
     pub fn vertical_fov_deg(&self) -> f32 {
         let (a, b) = (self.ray_ndc(Vec2::Y), self.ray_ndc(-Vec2::Y));
-        a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
+        // 2 asin(|a - b| / 2): exact for nearly parallel rays, where the
+        // acos of their dot product has only a few ulps left at 1080p.
+        2.0 * (0.5 * (a - b).length()).min(1.0).asin().to_degrees()
     }
 
     /// The camera-space point of clip `(ndc, depth)`.
@@ -268,7 +270,9 @@ impl View {
         let (cx, cy) = (0.5 * width.max(1) as f32, 0.5 * height.max(1) as f32);
         let a = self.camera_ray(cx, cy, width, height);
         let b = self.camera_ray(cx, cy + 1.0, width, height);
-        a.dot(b).clamp(-1.0, 1.0).acos()
+        // 2 asin(|a - b| / 2): exact for nearly parallel rays, where the
+        // acos of their dot product has only a few ulps left at 1080p.
+        2.0 * (0.5 * (a - b).length()).min(1.0).asin()
     }
 
     /// Distance from the eye to the surface a depth buffer holds `depth`

@@ -93,7 +93,10 @@ pub const BASE_WEIGHT: f32 = 0.85;
 /// between levels falls where a pixel already spans a texel or more).
 #[inline]
 pub fn lod_of(footprint_m: f32, texel_m: f32) -> f32 {
-    (footprint_m / texel_m).log2().max(0.0).round()
+    // The ratio is clamped before the log (a zero footprint: the first
+    // sample from inside the band, terrain shadows), since the GPU's log2
+    // of zero is undefined; WGSL's round sends halves to even.
+    (footprint_m / texel_m).max(1.0).log2().round_ties_even()
 }
 
 /// The coarsest mip level of the detail volume that is read (2³ texels;
