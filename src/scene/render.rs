@@ -38,9 +38,10 @@ pub struct RenderSettings {
     /// Extinction of the densest cloud, 1/m (> 0). Default 0.04.
     pub extinction_per_m: f32,
     /// Strength of the 3D detail noise eroding edges, 0..=1 (0: off, not
-    /// evaluated). Default 0.5.
+    /// evaluated). Default 0.6; at the cloud base 0.6 of it erodes, growing
+    /// to all of it at the top (`render::cpu::density::erosion_strength`).
     pub detail_strength: f32,
-    /// Size of the detail noise's features, m (> 0). Default 250.
+    /// Size of the detail noise's largest features, m (> 0). Default 180.
     pub detail_scale_m: f32,
     /// Primary march steps (1..=4096). Default 48 (chosen from
     /// `cumulus render --quality-report`, see README).
