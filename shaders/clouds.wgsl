@@ -135,13 +135,6 @@ fn detail_billows(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
     return gained(textureSampleLevel(noise_tex, wrap_linear, q, lod).g, lod);
 }
 
-// The detail noise from the 3D volume at the footprint's level of detail
-// (the CPU's `detail_noise`).
-fn detail_noise(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
-    let base = detail_base(p, scale_m, footprint_m);
-    return BASE_WEIGHT * base + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m);
-}
-
 // True where the coarse max-coverage mask says no P texel near map
 // coordinate `(u, v)` has coverage: the density there is zero, so the
 // texture reads are skipped.
@@ -254,8 +247,9 @@ fn surface_profile(m: f32, n: f32, s: f32, threshold: f32) -> f32 {
     return clamp((cloud_field(m, n, s) - threshold) / SURFACE_RAMP, 0.0, 1.0);
 }
 
-// surface_profile of the detail noise, reading the volume only where it
-// can change the result (the CPU's `detail_profile`).
+// surface_profile of the detail noise (the CPU's `detail_noise`: base and
+// billows weighted by BASE_WEIGHT), reading the volume only where it can
+// change the result (the CPU's `detail_profile`).
 fn detail_profile(p: vec3f, m: f32, threshold: f32, s: f32, scale_m: f32, footprint_m: f32) -> f32 {
     if surface_profile(m, 0.0, s, threshold) >= 1.0 {
         return 1.0;

@@ -148,7 +148,7 @@ fn torus(u: f64, v: f64, features: f64) -> [f64; 4] {
 /// The rank of each value among all, mapped to `(0, 1)`: a field with a
 /// uniform histogram, so a threshold at `1 - f` leaves the fraction `f`
 /// of the map above it. Ties are broken by index (deterministic).
-fn rank_uniform(values: impl Iterator<Item = f64>) -> Vec<f64> {
+pub(super) fn rank_uniform(values: impl Iterator<Item = f64>) -> Vec<f64> {
     let v: Vec<f64> = values.collect();
     let mut order: Vec<usize> = (0..v.len()).collect();
     order.sort_by(|&a, &b| v[a].total_cmp(&v[b]).then(a.cmp(&b)));

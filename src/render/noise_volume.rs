@@ -19,6 +19,8 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::cloud_map::rank_uniform;
+
 /// Texels per side.
 pub const SIZE: usize = 64;
 
@@ -188,14 +190,10 @@ fn remap(value: f64, lo: f64, hi: f64) -> f64 {
 
 /// Ranks of `values` mapped to 8 bits with a uniform histogram.
 fn rank_to_u8(values: &[f64]) -> Vec<u8> {
-    let mut order: Vec<usize> = (0..values.len()).collect();
-    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
-    let mut out = vec![0; values.len()];
-    let n = values.len().max(1) as f64;
-    for (rank, &i) in order.iter().enumerate() {
-        out[i] = (((rank as f64 + 0.5) / n) * 255.0).round() as u8;
-    }
-    out
+    rank_uniform(values.iter().copied())
+        .into_iter()
+        .map(|r| (r * 255.0).round() as u8)
+        .collect()
 }
 
 impl NoiseVolume {

@@ -150,15 +150,17 @@ impl HighPass {
     }
 }
 
+/// Luminance (Rec. 709 weights, `0..1`) of one sRGB8 pixel's values.
+fn luminance8(c: &[u8]) -> f64 {
+    (0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64) / 255.0
+}
+
 /// Mean over the `mask`ed pixels of the squared difference between the
 /// luminance of an sRGB8 image (`0..1`, the picture as displayed) and its
 /// 3x3 box mean (edges clamped).
 pub fn highpass_energy(rgb8: &[u8], mask: &[bool], width: u32, height: u32) -> f64 {
     let (w, h) = (width as i64, height as i64);
-    let lum: Vec<f64> = rgb8
-        .chunks_exact(3)
-        .map(|c| (0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64) / 255.0)
-        .collect();
+    let lum: Vec<f64> = rgb8.chunks_exact(3).map(luminance8).collect();
     let at = |x: i64, y: i64| lum[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize];
     let (mut sum, mut n) = (0.0, 0_usize);
     for y in 0..h {
@@ -193,12 +195,10 @@ pub fn pattern_correlation(
     width: u32,
     height: u32,
 ) -> f64 {
-    let lum =
-        |c: &[u8]| (0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64) / 255.0;
     let r: Vec<f64> = image
         .chunks_exact(3)
         .zip(reference.chunks_exact(3))
-        .map(|(a, b)| lum(a) - lum(b))
+        .map(|(a, b)| luminance8(a) - luminance8(b))
         .collect();
     let (w, h) = (width as i64, height as i64);
     let mut best: f64 = 0.0;
