@@ -150,14 +150,15 @@ fn coarse_empty(u: f32, v: f32) -> bool {
 
 // (cover, local top, fill, map value) at map coordinate uv, the map at
 // mip level map_lod (the CPU's `footprint`).
-fn footprint(u: f32, v: f32, map_lod: f32) -> vec4f {
+fn footprint(u: f32, v: f32, map_lod: f32, eta: f32) -> vec4f {
     let pf = textureSampleLevel(p_tex, wrap_linear, vec2f(u, v), 0.0);
-    if pf.r <= 1e-3 {
+    let highest = clamp(0.2 + 0.8 * pf.g, 0.0, 1.0);
+    if pf.r <= 1e-3 || eta >= highest {
         return vec4f(0.0);
     }
     let cm = textureSampleLevel(cm_tex, wrap_linear, vec2f(u, v), map_lod);
     let cover = clamp(frame.band.z * pf.r, 0.0, 1.0);
-    let top = clamp(0.2 + 0.8 * pf.g, 0.0, 1.0) * (0.7 + 0.3 * cm.g);
+    let top = highest * (0.7 + 0.3 * cm.g);
     return vec4f(cover, top, pf.b, cm.r);
 }
 
@@ -202,14 +203,14 @@ fn warped_lookup(x: f32, z: f32) -> vec3f {
 // The footprint at world (x, z) through the domain warp, the cover
 // modulated by the weather, the map at the footprint's level of detail
 // (the CPU's `world_footprint`).
-fn world_footprint(x: f32, z: f32, l: vec3f, footprint_m: f32) -> vec4f {
+fn world_footprint(x: f32, z: f32, l: vec3f, footprint_m: f32, eta: f32) -> vec4f {
     let u = l.x;
     let v = l.y;
     let k = l.z;
     if coarse_empty(u, v) {
         return vec4f(0.0);
     }
-    let fp = footprint(u, v, lod_of(footprint_m, frame.map.w));
+    let fp = footprint(u, v, lod_of(footprint_m, frame.map.w), eta);
     if fp.x <= 0.0 {
         return vec4f(0.0);
     }
@@ -283,7 +284,7 @@ fn density_at(p: vec3f, detail: bool, footprint_m: f32) -> f32 {
         return 0.0;
     }
     let lookup = warped_lookup(p.x, p.z);
-    let fp = world_footprint(p.x, p.z, lookup, footprint_m);
+    let fp = world_footprint(p.x, p.z, lookup, footprint_m, eta);
     if fp.x <= 0.0 || eta >= fp.y {
         return 0.0;
     }
@@ -312,32 +313,16 @@ fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
         + 0.25 * phase_hg(cos_theta, -0.3 * eccentricity);
 }
 
-fn sun_optical_depth(p: vec3f, sun_dir: vec3f, footprint_m: f32) -> f32 {
-    if SHADOW_STEPS == 0u {
-        return 0.0;
-    }
+// The length of the shadow ray from p toward the sun: to the band's top,
+// at most SHADOW_RAY_M (the CPU's `shadow_ray_length`). The march takes
+// its SHADOW_STEPS steps of growing length (1, 2, 3, ... parts) itself,
+// as the CPU's `sun_optical_depth` does.
+fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
     var to_top = SHADOW_RAY_M;
     if sun_dir.y > 1e-3 {
         to_top = max(frame.band.y - p.y, 0.0) / sun_dir.y;
     }
-    let length = min(to_top, SHADOW_RAY_M);
-    let parts = f32(SHADOW_STEPS * (SHADOW_STEPS + 1u) / 2u);
-    var t = 0.0;
-    var tau = 0.0;
-    for (var i = 0u; i < SHADOW_STEPS; i++) {
-        let dt = length * f32(i + 1u) / parts;
-        let q = p + sun_dir * (t + 0.5 * dt);
-        if height_fraction(q.y) > 1.0 {
-            break;
-        }
-        tau += density_at(q, false, footprint_m) * dt;
-        t += dt;
-    }
-    return tau;
-}
-
-fn sun_transmittance(p: vec3f, sun_dir: vec3f, footprint_m: f32) -> f32 {
-    return exp(-sun_optical_depth(p, sun_dir, footprint_m));
+    return min(to_top, SHADOW_RAY_M);
 }
 
 fn sun_scattering(tau_sun: f32, cos_theta: f32) -> f32 {
@@ -439,6 +424,14 @@ struct CloudSample {
 
 // Marches the band segment of one ray up to `max_t` (the twin of
 // `march_ray` less the background, which the composite pass adds).
+//
+// The CPU's march nests three loops: coarse intervals, the REFINE
+// sub-samples of those that touch cloud, and the shadow ray of each lit
+// sub-sample. Here they are one loop that reads the density once per
+// iteration, the same reads in the same order with the same arithmetic:
+// neighbouring pixels that run in lockstep on a GPU (a SIMD group) then
+// each go on with their own next read, instead of all waiting while one
+// of them refines an interval or marches a shadow ray.
 fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample {
     var out: CloudSample;
     out.premultiplied = vec4f(0.0);
@@ -457,51 +450,121 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let sun = frame.sun_light.xyz;
     let ambient_top = frame.ambient_top.xyz;
     let cos_theta = dot(dir, sun_dir);
+    let parts = f32(SHADOW_STEPS * (SHADOW_STEPS + 1u) / 2u);
     var transmittance = 1.0;
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
     var samples = 1u;
     var sigma_a = density_at(origin + dir * t0, true, spread * t0);
+    // Coarse intervals begun; the current one's sub-samples taken and
+    // planned (planned = taken: probe the next interval's far end), its
+    // start and sub-step.
+    var i = 0u;
+    var j = 0u;
+    var n = 0u;
+    var start = t0;
+    var h = 0.0;
     var ta = t0;
-    for (var i = 0u; i < steps; i++) {
-        let tb = march_distance(t0, log_ratio, f32(i + 1u) / f32(steps));
-        let sigma_b = density_at(origin + dir * tb, true, spread * tb);
+    var tb = t0;
+    // The lit sub-sample whose light is still to be added, and its shadow
+    // ray: steps taken (SHADOW_STEPS: done), length, distance, optical
+    // depth so far.
+    var lit = false;
+    var lit_t = 0.0;
+    var lit_p = vec3f(0.0);
+    var lit_footprint = 0.0;
+    var lit_sigma = 0.0;
+    var k = SHADOW_STEPS;
+    var shadow_length = 0.0;
+    var shadow_t = 0.0;
+    var tau = 0.0;
+    var tau_sun = 0.0;
+    loop {
+        // What this iteration reads: the lit sample's next shadow step,
+        // else (its light added first) the next sub-sample or interval end.
+        var q = vec3f(0.0);
+        var q_footprint = 0.0;
+        var dt = 0.0;
+        var kind = 0u; // 0: interval end, 1: sub-sample, 2: shadow step
+        var t = 0.0;
+        if k < SHADOW_STEPS {
+            dt = shadow_length * f32(k + 1u) / parts;
+            q = lit_p + sun_dir * (shadow_t + 0.5 * dt);
+            if height_fraction(q.y) > 1.0 {
+                k = SHADOW_STEPS;
+            } else {
+                kind = 2u;
+                q_footprint = lit_footprint;
+            }
+            if k == SHADOW_STEPS {
+                tau_sun = tau;
+            }
+        }
+        if kind != 2u {
+            if lit {
+                lit = false;
+                let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
+                let ambient = ambient_top * (0.35 + 0.65 * eta);
+                let scatter = sun * sun_scattering(tau_sun, cos_theta) + ambient;
+                let s = scatter * (lit_sigma * ALBEDO);
+                let step_t = exp(-lit_sigma * h);
+                light += integrate_step(s, lit_sigma, h) * transmittance;
+                depth_weighted += lit_t * transmittance * (1.0 - step_t);
+                transmittance *= step_t;
+                if transmittance < MIN_TRANSMITTANCE {
+                    break;
+                }
+            }
+            if j == n {
+                if i == steps {
+                    break;
+                }
+                tb = march_distance(t0, log_ratio, f32(i + 1u) / f32(steps));
+                q = origin + dir * tb;
+                q_footprint = spread * tb;
+            } else {
+                kind = 1u;
+                t = start + (f32(j) + dither) * h;
+                q = origin + dir * t;
+                q_footprint = spread * t;
+            }
+        }
+        let sigma = density_at(q, kind != 2u, q_footprint);
         samples += 1u;
-        let touched = sigma_a > 0.0 || sigma_b > 0.0;
-        sigma_a = sigma_b;
-        var n = 1u;
-        var h = tb - ta;
-        if touched {
-            n = REFINE;
-            h = (tb - ta) / f32(REFINE);
-        }
-        let start = ta;
-        ta = tb;
-        for (var j = 0u; j < n; j++) {
-            let t = start + (f32(j) + dither) * h;
-            let p = origin + dir * t;
-            let footprint = spread * t;
-            let sigma_t = density_at(p, true, footprint);
-            samples += 1u;
-            if sigma_t <= 0.0 {
-                continue;
+        if kind == 2u {
+            tau += sigma * dt;
+            shadow_t += dt;
+            k += 1u;
+            if k == SHADOW_STEPS {
+                tau_sun = tau;
             }
-            let tau_sun = sun_optical_depth(p, sun_dir, footprint);
-            samples += SHADOW_STEPS;
-            let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-            let ambient = ambient_top * (0.35 + 0.65 * eta);
-            let scatter = sun * sun_scattering(tau_sun, cos_theta) + ambient;
-            let s = scatter * (sigma_t * ALBEDO);
-            let step_t = exp(-sigma_t * h);
-            light += integrate_step(s, sigma_t, h) * transmittance;
-            depth_weighted += t * transmittance * (1.0 - step_t);
-            transmittance *= step_t;
-            if transmittance < MIN_TRANSMITTANCE {
-                break;
+        } else if kind == 0u {
+            let touched = sigma_a > 0.0 || sigma > 0.0;
+            sigma_a = sigma;
+            n = 1u;
+            h = tb - ta;
+            if touched {
+                n = REFINE;
+                h = (tb - ta) / f32(REFINE);
             }
-        }
-        if transmittance < MIN_TRANSMITTANCE {
-            break;
+            start = ta;
+            ta = tb;
+            j = 0u;
+            i += 1u;
+        } else {
+            j += 1u;
+            if sigma > 0.0 {
+                lit = true;
+                lit_t = t;
+                lit_p = q;
+                lit_footprint = q_footprint;
+                lit_sigma = sigma;
+                tau = 0.0;
+                tau_sun = 0.0;
+                shadow_t = 0.0;
+                shadow_length = shadow_ray_length(q, sun_dir);
+                k = 0u;
+            }
         }
     }
     let opacity = 1.0 - transmittance;

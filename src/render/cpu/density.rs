@@ -220,22 +220,28 @@ pub const SURFACE_RAMP: f32 = 0.08;
 /// cloud top (normalised; from the parcels' height, taller where the
 /// map's large-scale pattern is high), `fill` P's fill, and
 /// `m` the cloud map's multi-scale value there, read at the mip level
-/// `map_lod`. `(0, 0, 0, 0)` where P has no coverage.
+/// `map_lod`. `(0, 0, 0, 0)` where P has no coverage, or where the
+/// normalised height `eta` of the point asking is at or above the highest
+/// top P allows there (the map's factor is at most 1): no cloud there
+/// whatever the map says, so the map is not read (the density is the
+/// same, bit for bit).
 #[inline]
 pub fn footprint(
     u: f32,
     v: f32,
     map_lod: f32,
+    eta: f32,
     f: &Fields,
     d: &DensityParams,
 ) -> (f32, f32, f32, f32) {
     let [c, h, fill] = f.p.sample(u, v);
-    if c <= 1e-3 {
+    let highest = (0.2 + 0.8 * h).clamp(0.0, 1.0);
+    if c <= 1e-3 || eta >= highest {
         return (0.0, 0.0, 0.0, 0.0);
     }
     let [m, large] = f.cloud_map.sample_level(u, v, map_lod);
     let cover = (d.coverage * c).clamp(0.0, 1.0);
-    let top = (0.2 + 0.8 * h).clamp(0.0, 1.0) * (0.7 + 0.3 * large);
+    let top = highest * (0.7 + 0.3 * large);
     (cover, top, fill, m)
 }
 
@@ -337,11 +343,19 @@ pub fn world_footprint(
     z: f32,
     lookup: (f32, f32, f32),
     footprint_m: f32,
+    eta: f32,
     f: &Fields,
     d: &DensityParams,
 ) -> (f32, f32, f32, f32) {
     let (u, v, k) = lookup;
-    let (cover, top, fill, m) = footprint(u, v, lod_of(footprint_m, map_texel_m(f, d)), f, d);
+    let (cover, top, fill, m) = footprint(
+        u,
+        v,
+        lod_of(footprint_m, map_texel_m(f, d)),
+        eta,
+        f,
+        d,
+    );
     if cover <= 0.0 {
         return (0.0, 0.0, 0.0, 0.0);
     }
@@ -426,7 +440,7 @@ pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool, footprin
         return 0.0;
     }
     let lookup = warped_lookup(p.x, p.z, d.map_extent_m);
-    let (cover, top, fill, m) = world_footprint(p.x, p.z, lookup, footprint_m, f, d);
+    let (cover, top, fill, m) = world_footprint(p.x, p.z, lookup, footprint_m, eta, f, d);
     if cover <= 0.0 || eta >= top {
         return 0.0;
     }

@@ -24,6 +24,19 @@ pub fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
 /// The longest shadow ray toward the sun, m (`SHADOW_RAY_M` in WGSL).
 pub const SHADOW_RAY_M: f32 = 2000.0;
 
+/// The length of the shadow ray from `p` toward the sun: to the band's
+/// top, at most [`SHADOW_RAY_M`] (along a sun at or below the horizon,
+/// that).
+#[inline]
+pub fn shadow_ray_length(p: Vec3, sun_dir: Vec3, d: &DensityParams) -> f32 {
+    let to_top = if sun_dir.y > 1e-3 {
+        (d.band_top_m - p.y).max(0.0) / sun_dir.y
+    } else {
+        SHADOW_RAY_M
+    };
+    to_top.min(SHADOW_RAY_M)
+}
+
 /// Optical depth (dimensionless) from `p` toward the sun through the band,
 /// by `steps` samples with growing step lengths (1, 2, 3, ... parts) over
 /// at most [`SHADOW_RAY_M`]. The detail noise is left out of shadow rays: it changes
@@ -41,12 +54,7 @@ pub fn sun_optical_depth(
     if steps == 0 {
         return 0.0;
     }
-    let to_top = if sun_dir.y > 1e-3 {
-        (d.band_top_m - p.y).max(0.0) / sun_dir.y
-    } else {
-        SHADOW_RAY_M
-    };
-    let length = to_top.min(SHADOW_RAY_M);
+    let length = shadow_ray_length(p, sun_dir, d);
     let parts = (steps * (steps + 1) / 2) as f32;
     let mut t = 0.0;
     let mut tau = 0.0;
