@@ -8,6 +8,10 @@
 // over it with premultiplied alpha).
 
 override ENCODE_SRGB: bool = false;
+// Off for a floating-point (HDR) target, which receives the linear
+// radiance untouched, for an engine's own exposure and tone map (and the
+// CLI's OpenEXR output).
+override TONE_MAP: bool = true;
 
 @group(1) @binding(0) var cloud_tex: texture_2d<f32>;
 
@@ -19,10 +23,13 @@ fn srgb_encode(x: f32) -> f32 {
 }
 
 // Tone map (the CPU `tone_map`), then sRGB-encode when the target is not an
-// sRGB format (an sRGB target encodes in hardware).
+// sRGB format (an sRGB target encodes in hardware); an HDR target gets the
+// linear radiance.
 fn display(c: vec3f) -> vec3f {
-    let e = frame.ambient_top.w;
-    let m = vec3f(tone_map(c.x, e), tone_map(c.y, e), tone_map(c.z, e));
+    if !TONE_MAP {
+        return max(c, vec3f(0.0));
+    }
+    let m = tone_map(c, frame.ambient_top.w);
     if ENCODE_SRGB {
         return vec3f(srgb_encode(m.x), srgb_encode(m.y), srgb_encode(m.z));
     }

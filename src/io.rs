@@ -89,6 +89,18 @@ pub fn write_png_atomically(path: &Path, img: &image::RgbImage) -> std::io::Resu
     write_atomically(path, |out| out.write_all(&png))
 }
 
+/// Encodes linear RGB radiance as OpenEXR (32-bit float channels, scene
+/// linear, no tone map) and writes it atomically.
+pub fn write_exr_atomically(path: &Path, img: &image::Rgb32FImage) -> std::io::Result<()> {
+    let mut exr = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut exr),
+        image::ImageFormat::OpenExr,
+    )
+    .map_err(std::io::Error::other)?;
+    write_atomically(path, |out| out.write_all(&exr))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

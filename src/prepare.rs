@@ -10,6 +10,7 @@ use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::density::Fields;
 use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::gpu::baseline::Sphere;
+use crate::render::gpu::headless::TARGET_FORMAT;
 use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless};
 use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
@@ -85,13 +86,27 @@ impl Prepared {
         width: u32,
         height: u32,
     ) -> Result<Headless, GpuError> {
-        Headless::new(
+        self.headless_with_format(ctx, settings, width, height, TARGET_FORMAT)
+    }
+
+    /// [`Self::headless`] with a target of `format` (`HDR_FORMAT`: linear
+    /// radiance, for OpenEXR).
+    pub fn headless_with_format(
+        &self,
+        ctx: &GpuContext,
+        settings: &GpuSettings,
+        width: u32,
+        height: u32,
+        format: wgpu::TextureFormat,
+    ) -> Result<Headless, GpuError> {
+        Headless::with_format(
             ctx,
             &self.field,
             &self.cloud_map,
             self.terrain.as_ref(),
             settings,
             (width, height),
+            format,
         )
     }
 

@@ -599,6 +599,7 @@ fn every_help_shows_an_example() {
         &["render"],
         &["bench"],
         &["stats"],
+        &["export"],
         &["scene", "check"],
     ] {
         let mut args = cmd.to_vec();

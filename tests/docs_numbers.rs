@@ -230,6 +230,7 @@ fn readme_command_table_lists_every_flag() {
         "render",
         "bench",
         "stats",
+        "export",
     ] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_cumulus"))
             .args([cmd, "--help"])

@@ -98,7 +98,17 @@ fn cloud_top_rises_with_the_parcel_height_channel() {
             cloud_map: &cm,
         };
         (0..400)
-            .map(|i| footprint((i % 20) as f32 / 20.0, (i / 20) as f32 / 20.0, 0.0, 0.0, &f, &D).1)
+            .map(|i| {
+                footprint(
+                    (i % 20) as f32 / 20.0,
+                    (i / 20) as f32 / 20.0,
+                    0.0,
+                    0.0,
+                    &f,
+                    &D,
+                )
+                .1
+            })
             .fold(0.0, f32::max)
     };
     let (low, mid, high) = (top_of(0.1), top_of(0.5), top_of(1.0));

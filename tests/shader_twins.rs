@@ -26,7 +26,6 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("view_depth", "no depth buffer on the CPU"),
     // Tone map plus sRGB encode of the composite; the CPU's to_srgb8.
     ("display", "the CPU's to_srgb8"),
-    ("srgb_encode", "inside the CPU's to_srgb8"),
     // glam's Vec3::normalize_or on the CPU.
     ("normalize_or", "glam's Vec3::normalize_or"),
     // The composite's background: sky_radiance + sun_disk on the CPU.

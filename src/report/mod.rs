@@ -1,5 +1,7 @@
-//! Reports built on the simulator: parcel curves (the paper's Fig. 5) as
-//! CSV, and error against run time.
+//! Reports built on the simulator and the renderer: parcel curves (the
+//! paper's Fig. 5) as CSV, error against run time and against render
+//! cost, GPU benchmarks, field statistics, and the density volume for
+//! offline renderers.
 
 pub mod convergence;
 pub mod curves;
@@ -7,6 +9,7 @@ pub mod field_stats;
 pub mod gpu_bench;
 pub mod plot;
 pub mod render_quality;
+pub mod volume_export;
 
 /// What went wrong writing a report.
 #[derive(Debug, thiserror::Error)]

@@ -45,11 +45,7 @@ pub struct Report {
 }
 
 fn tone(c: Vec3, exposure: f32) -> Vec3 {
-    Vec3::new(
-        tone_map(c.x, exposure),
-        tone_map(c.y, exposure),
-        tone_map(c.z, exposure),
-    )
+    tone_map(c, exposure)
 }
 
 /// Renders `frame` at every count in `steps` and at the reference.

@@ -1,5 +1,6 @@
 //! `cumulus`: the command line, one module per command (`simulate.rs`,
-//! `profile.rs`, `convergence.rs`, `render.rs`, `bench.rs`, `stats.rs`;
+//! `profile.rs`, `convergence.rs`, `render.rs`, `bench.rs`, `stats.rs`,
+//! `export.rs`;
 //! `scene check`
 //! is here). Units are in every flag's name and help text. Errors leave
 //! through `anyhow` with the file, line or field. This is the binary's
@@ -8,6 +9,7 @@
 
 mod bench;
 mod convergence;
+mod export;
 mod profile;
 mod render;
 mod simulate;
@@ -59,6 +61,12 @@ enum Command {
     /// cloud-size density and its power-law exponent (CSV, JSON, plots).
     #[command(allow_negative_numbers = true)]
     Stats(stats::StatsArgs),
+    /// Write the density field the renderer marches (extinction per
+    /// metre on a grid over a box) as a Mitsuba 3 grid volume (.vol), with
+    /// the sun, camera, phase function and albedo in a JSON sidecar, for
+    /// offline renderers.
+    #[command(allow_negative_numbers = true)]
+    Export(export::ExportArgs),
     /// Scene files.
     Scene {
         #[command(subcommand)]
@@ -93,6 +101,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => render::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Stats(a) => stats::run(a),
+        Command::Export(a) => export::run(a),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => {

@@ -1,13 +1,14 @@
 //! `cumulus render`: simulate a scene, then render one picture on the GPU
 //! or with the CPU reference (and the render-quality report).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use cumulus::io::write_png_atomically;
+use cumulus::io::{write_exr_atomically, write_png_atomically};
 use cumulus::prepare::Prepared;
 use cumulus::render::gpu::GpuContext;
+use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
 use cumulus::scene::Scene;
 
 use crate::{
@@ -23,8 +24,9 @@ pub struct RenderArgs {
     /// Scene TOML file.
     #[arg(long)]
     scene: PathBuf,
-    /// Output PNG (written atomically). Needed unless --quality-report is
-    /// given.
+    /// Output picture, written atomically: .png (tone-mapped with ACES
+    /// filmic at render.exposure, sRGB) or .exr (OpenEXR, linear radiance,
+    /// no tone map). Needed unless --quality-report is given.
     #[arg(long, required_unless_present = "quality_report")]
     out: Option<PathBuf>,
     /// Also write the error-against-cost report (render_quality.csv/.png)
@@ -58,6 +60,38 @@ pub struct RenderArgs {
     /// adapter has them, else CPU wall time (labelled).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100000))]
     time_frames: Option<u32>,
+}
+
+/// What `--out` holds, from its extension.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Picture {
+    /// Tone-mapped sRGB, 8 bits.
+    Png,
+    /// Linear radiance, 32-bit floats.
+    Exr,
+}
+
+impl Picture {
+    fn of(path: &Path) -> Result<Self> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("exr") => Ok(Self::Exr),
+            _ => bail!(
+                "{}: --out must end in .png (tone-mapped picture) or .exr (linear radiance)",
+                path.display()
+            ),
+        }
+    }
+}
+
+/// Writes linear RGB radiance (`rgb`, row-major) as OpenEXR.
+fn write_exr(out: &Path, width: u32, height: u32, rgb: Vec<f32>) -> Result<()> {
+    let img = image::Rgb32FImage::from_raw(width, height, rgb).context("image buffer size")?;
+    write_exr_atomically(out, &img)
+        .with_context(|| format!("{}: cannot write image", out.display()))
 }
 
 /// Which renderer draws the image.
@@ -95,6 +129,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     })?;
     if let Some(out) = &a.out {
         check_output_file(out)?;
+        Picture::of(out)?;
         guard_output_file(out);
     }
     let gpu = match a.backend {
@@ -186,10 +221,17 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let start = std::time::Instant::now();
     let linear = render_linear_offsets(r.width, r.height, &frame, r.cpu_offsets);
     let elapsed = start.elapsed();
-    let bytes = to_srgb8(&linear, r.exposure);
-    let img = image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
-    write_png_atomically(out, &img)
-        .with_context(|| format!("{}: cannot write image", out.display()))?;
+
+    if Picture::of(out)? == Picture::Exr {
+        let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
+        write_exr(out, r.width, r.height, rgb)?;
+    } else {
+        let bytes = to_srgb8(&linear, r.exposure);
+        let img =
+            image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
+        write_png_atomically(out, &img)
+            .with_context(|| format!("{}: cannot write image", out.display()))?;
+    }
     eprintln!(
         "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
@@ -212,17 +254,26 @@ fn render_gpu(ctx: &GpuContext, a: &RenderArgs, scene: &Scene, prepared: &Prepar
     let r = &scene.render;
     eprintln!("backend: gpu ({})", ctx.describe());
     let settings = prepared.gpu_settings(r, r.quality());
-    let mut hl = prepared.headless(ctx, &settings, r.width, r.height)?;
+    let picture = a.out.as_deref().map(Picture::of).transpose()?;
+    let format = match picture {
+        Some(Picture::Exr) => HDR_FORMAT,
+        _ => TARGET_FORMAT,
+    };
+    let mut hl = prepared.headless_with_format(ctx, &settings, r.width, r.height, format)?;
     let frames = a.frames.unwrap_or(if r.tsaa { 32 } else { 1 });
     let start = std::time::Instant::now();
     hl.render(ctx, &r.camera(), frames)?;
     let elapsed = start.elapsed();
     if let Some(out) = &a.out {
-        let bytes = hl.read_rgb8(ctx)?;
-        let img =
-            image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
-        write_png_atomically(out, &img)
-            .with_context(|| format!("{}: cannot write image", out.display()))?;
+        if let Some(rgb) = hl.read_linear(ctx)? {
+            write_exr(out, r.width, r.height, rgb)?;
+        } else {
+            let bytes = hl.read_rgb8(ctx)?;
+            let img =
+                image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
+            write_png_atomically(out, &img)
+                .with_context(|| format!("{}: cannot write image", out.display()))?;
+        }
         eprintln!(
             "rendered {}x{}, {frames} frame(s) in {:.2} s ({} steps, {} shadow steps, {} octaves, TSAA {}; passes {}); wrote {}",
             r.width,

@@ -348,14 +348,7 @@ pub fn world_footprint(
     d: &DensityParams,
 ) -> (f32, f32, f32, f32) {
     let (u, v, k) = lookup;
-    let (cover, top, fill, m) = footprint(
-        u,
-        v,
-        lod_of(footprint_m, map_texel_m(f, d)),
-        eta,
-        f,
-        d,
-    );
+    let (cover, top, fill, m) = footprint(u, v, lod_of(footprint_m, map_texel_m(f, d)), eta, f, d);
     if cover <= 0.0 {
         return (0.0, 0.0, 0.0, 0.0);
     }

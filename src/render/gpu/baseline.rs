@@ -63,6 +63,10 @@ impl BaselineRenderer {
         let module = bind::module(device, "baseline", super::shaders::baseline_pass());
         let mut constants = settings.constants();
         constants.push(("ENCODE_SRGB", (!format.is_srgb()) as u8 as f64));
+        constants.push((
+            "TONE_MAP",
+            (!super::composite_pass::is_hdr(format)) as u8 as f64,
+        ));
         let pipeline = bind::full_screen_pipeline(
             device,
             "baseline",

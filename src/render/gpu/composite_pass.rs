@@ -9,6 +9,17 @@ use super::shaders::{self, Background};
 /// The pass's name.
 pub const PASS_COMPOSITE: &str = "composite";
 
+/// Whether `format` is a floating-point colour format: such a target
+/// receives linear radiance, not tone-mapped and encoded pixels.
+pub fn is_hdr(format: wgpu::TextureFormat) -> bool {
+    matches!(
+        format,
+        wgpu::TextureFormat::Rgba16Float
+            | wgpu::TextureFormat::Rgba32Float
+            | wgpu::TextureFormat::Rg11b10Ufloat
+    )
+}
+
 /// One pipeline per background, built on first use.
 #[derive(Default)]
 pub struct CompositePass {
@@ -52,6 +63,7 @@ impl CompositePass {
         let encode = if target_format.is_srgb() { 0.0 } else { 1.0 };
         let mut constants = constants.to_vec();
         constants.push(("ENCODE_SRGB", encode));
+        constants.push(("TONE_MAP", (!is_hdr(target_format)) as u8 as f64));
         let pipeline = bind::full_screen_pipeline(
             device,
             "composite",

@@ -14,14 +14,24 @@ use crate::sim::ProjectedField;
 /// The offscreen target's format: 8-bit sRGB, the CPU `to_srgb8`'s encoding.
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
-/// An offscreen target that can be read back.
-pub fn target(ctx: &GpuContext, width: u32, height: u32) -> wgpu::Texture {
+/// The HDR offscreen target's format: linear radiance as 32-bit floats,
+/// not tone-mapped (the composite pass leaves a float target linear), for
+/// OpenEXR output.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// An offscreen target of `format` that can be read back.
+pub fn target(
+    ctx: &GpuContext,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
     textures::create_2d(
         &ctx.device,
         "headless.target",
         width,
         height,
-        TARGET_FORMAT,
+        format,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
     )
 }
@@ -41,20 +51,43 @@ impl Headless {
         cloud_map: &CloudMap,
         terrain: Option<&Heightfield>,
         settings: &GpuSettings,
+        size: (u32, u32),
+    ) -> Result<Self, GpuError> {
+        Self::with_format(
+            ctx,
+            field,
+            cloud_map,
+            terrain,
+            settings,
+            size,
+            TARGET_FORMAT,
+        )
+    }
+
+    /// [`Self::new`] with a target of `format`: [`TARGET_FORMAT`] for
+    /// tone-mapped sRGB pixels ([`Self::read_rgb8`]), [`HDR_FORMAT`] for
+    /// linear radiance ([`Self::read_linear`]).
+    pub fn with_format(
+        ctx: &GpuContext,
+        field: &ProjectedField,
+        cloud_map: &CloudMap,
+        terrain: Option<&Heightfield>,
+        settings: &GpuSettings,
         (width, height): (u32, u32),
+        format: wgpu::TextureFormat,
     ) -> Result<Self, GpuError> {
         ctx.checked(|| {
             let mut renderer = CloudRenderer::new(
                 &ctx.device,
                 &ctx.queue,
-                TARGET_FORMAT,
+                format,
                 settings,
                 cloud_map,
                 terrain,
             );
             renderer.update_field(&ctx.queue, field);
             renderer.resize(width, height);
-            let target = target(ctx, width, height);
+            let target = target(ctx, width, height, format);
             Self { renderer, target }
         })
     }
@@ -62,7 +95,7 @@ impl Headless {
     /// Resizes the renderer and the target.
     pub fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) {
         self.renderer.resize(width, height);
-        self.target = target(ctx, width, height);
+        self.target = target(ctx, width, height, self.target.format());
     }
 
     /// Renders `frames` frames from `camera` (TSAA accumulates across them)
@@ -94,6 +127,24 @@ impl Headless {
             r
         })??;
         Ok(())
+    }
+
+    /// The linear radiance of a [`HDR_FORMAT`] target, RGB per pixel,
+    /// row-major; `None` for a target of another format.
+    pub fn read_linear(&self, ctx: &GpuContext) -> Result<Option<Vec<f32>>, GpuError> {
+        if self.target.format() != HDR_FORMAT {
+            return Ok(None);
+        }
+        let rgba: Vec<f32> = ctx
+            .read_texture(&self.target, 16)?
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        Ok(Some(
+            rgba.chunks_exact(4)
+                .flat_map(|p| [p[0], p[1], p[2]])
+                .collect(),
+        ))
     }
 
     /// The target's pixels as tightly packed RGB8 (sRGB).

@@ -1,0 +1,247 @@
+//! What `cumulus` writes for other programs: OpenEXR pictures of linear
+//! radiance (CPU and GPU) and the density volume of `cumulus export`,
+//! each read back and checked against the library.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use cumulus::prepare::Prepared;
+use cumulus::render::cpu::density::density_at;
+use cumulus::render::cpu::renderer::{to_srgb8, tone_map};
+use cumulus::report::volume_export::{Grid, read_vol};
+use cumulus::scene::Scene;
+use glam::Vec3;
+
+fn cumulus(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn scene_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.toml"))
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn render(out: &Path, extra: &[&str]) -> Output {
+    let scene = scene_path("fair_weather");
+    let mut args = vec![
+        "render",
+        "--scene",
+        scene.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--time-s",
+        "600",
+    ];
+    args.extend(extra);
+    cumulus(&args)
+}
+
+fn read_exr(path: &Path) -> (u32, u32, Vec<Vec3>) {
+    let img = image::open(path).expect("an EXR image reads").to_rgb32f();
+    let (w, h) = img.dimensions();
+    let px = img.pixels().map(|p| Vec3::from_array(p.0)).collect();
+    (w, h, px)
+}
+
+/// The CPU's `.exr` holds the very linear radiance its `.png` tone-maps:
+/// tone-mapping the EXR's floats gives the PNG's bytes exactly (an EXR of
+/// display values, tone-mapped once more, would come out darker).
+#[test]
+fn the_cpu_exr_is_the_linear_radiance_the_png_tone_maps() {
+    let dir = tempfile::tempdir().expect("dir");
+    let (png, exr) = (dir.path().join("a.png"), dir.path().join("a.exr"));
+    for out in [&png, &exr] {
+        let o = render(out, &["--backend", "cpu"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let (w, h, linear) = read_exr(&exr);
+    assert_eq!((w, h), (64, 48));
+    let exposure = Scene::load(&scene_path("fair_weather"))
+        .expect("scene")
+        .render
+        .exposure;
+    let png_bytes = image::open(&png).expect("png").to_rgb8().into_raw();
+    assert_eq!(to_srgb8(&linear, exposure), png_bytes);
+}
+
+/// The GPU's `.exr` comes from a float target, which the composite pass
+/// leaves linear: tone-mapping its floats on the CPU gives the GPU's own
+/// `.png` of the same frames within two levels (the PNG's target encodes
+/// in 8 bits and the GPU's arithmetic differs in the last bits).
+#[test]
+fn the_gpu_exr_is_linear_and_tone_maps_to_the_gpu_png() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("dir");
+    let (png, exr) = (dir.path().join("g.png"), dir.path().join("g.exr"));
+    for out in [&png, &exr] {
+        let o = render(out, &["--backend", "gpu", "--frames", "2"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let (w, h, linear) = read_exr(&exr);
+    assert_eq!((w, h), (64, 48));
+    let exposure = Scene::load(&scene_path("fair_weather"))
+        .expect("scene")
+        .render
+        .exposure;
+    let ours = to_srgb8(&linear, exposure);
+    let gpu = image::open(&png).expect("png").to_rgb8().into_raw();
+    let worst = ours
+        .iter()
+        .zip(&gpu)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    assert!(worst <= 2, "largest difference {worst} levels");
+    // Display values tone-mapped a second time would be far off.
+    let twice: Vec<Vec3> = linear.iter().map(|&c| tone_map(c, exposure)).collect();
+    let off = to_srgb8(&twice, exposure)
+        .iter()
+        .zip(&gpu)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    assert!(off > 10, "the test tells linear from display values: {off}");
+}
+
+#[test]
+fn a_picture_name_that_is_neither_png_nor_exr_is_refused() {
+    let dir = tempfile::tempdir().expect("dir");
+    let out = dir.path().join("sky.jpg");
+    let o = render(&out, &["--backend", "cpu"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("sky.jpg") && e.contains(".png") && e.contains(".exr"),
+        "{e}"
+    );
+    assert!(std::fs::read_dir(dir.path()).expect("dir").next().is_none());
+}
+
+/// `cumulus export` writes the grid the library's `density_at` gives at
+/// the cell centres (for the same scene, simulated the same way), and a
+/// sidecar that places it, lights it and frames it.
+#[test]
+fn export_writes_the_density_the_renderer_marches() {
+    let dir = tempfile::tempdir().expect("dir");
+    let out = dir.path().join("clouds.vol");
+    let scene = scene_path("fair_weather");
+    let o = cumulus(&[
+        "export",
+        "--scene",
+        scene.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--cells",
+        "64",
+        "--time-s",
+        "900",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (grid, values) = read_vol(&out).expect("the volume reads back");
+
+    let mut sc = Scene::load(&scene).expect("scene");
+    sc.render.time_s = 900.0;
+    let prepared = Prepared::from_scene(&sc, || {}).expect("prepare");
+    let frame = prepared.frame(&sc.render, sc.render.quality());
+    let d = frame.density;
+    let expected = Grid::cubic(
+        64,
+        Vec3::new(0.0, d.band_bottom_m, 0.0),
+        Vec3::new(d.map_extent_m, d.band_top_m, d.map_extent_m),
+    )
+    .expect("grid");
+    assert_eq!(grid, expected);
+    let footprint = grid.cell_m().min_element();
+    let [nx, ny, nz] = grid.resolution;
+    let mut cloudy = 0;
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in (k * 7 + j) % 3..nx {
+                if i % 3 != 0 {
+                    continue;
+                }
+                let want = density_at(grid.centre(i, j, k), &frame.fields, &d, true, footprint);
+                assert_eq!(values[grid.index(i, j, k)], want, "cell {i} {j} {k}");
+                cloudy += (want > 0.0) as usize;
+            }
+        }
+    }
+    assert!(cloudy > 50, "the box holds cloud: {cloudy} checked cells");
+    let most = values.iter().copied().fold(0.0, f32::max);
+    assert!(most > 0.0 && most <= d.extinction_per_m);
+
+    let text = std::fs::read_to_string(out.with_extension("json")).expect("sidecar");
+    let j: serde_json::Value = serde_json::from_str(&text).expect("json");
+    assert_eq!(j["volume"], "clouds.vol");
+    assert_eq!(j["resolution"], serde_json::json!(grid.resolution));
+    let m = |r: usize, c: usize| j["to_world"][r][c].as_f64().expect("number") as f32;
+    // The unit cube's corners land on the box's.
+    for (u, corner) in [(0.0, grid.min_m), (1.0, grid.max_m)] {
+        let mapped = Vec3::new(
+            m(0, 0) * u + m(0, 3),
+            m(1, 1) * u + m(1, 3),
+            m(2, 2) * u + m(2, 3),
+        );
+        assert!((mapped - corner).length() < 1e-2, "{mapped} {corner}");
+    }
+    assert_eq!(
+        j["max_extinction_per_m"].as_f64().map(|v| v as f32),
+        Some(most)
+    );
+    let sun: Vec<f64> = serde_json::from_value(j["sun_direction"].clone()).expect("sun");
+    let norm = sun.iter().map(|x| x * x).sum::<f64>().sqrt();
+    assert!((norm - 1.0).abs() < 1e-5 && sun[1] > 0.0);
+    assert_eq!(j["phase"][0]["g"].as_f64().map(|v| v as f32), Some(0.8));
+    assert_eq!(j["albedo"].as_f64().map(|v| v as f32), Some(0.99));
+    assert_eq!(j["width"], 640);
+}
+
+#[test]
+fn export_refuses_bad_grids_boxes_and_names_before_simulating() {
+    let dir = tempfile::tempdir().expect("dir");
+    let scene = scene_path("fair_weather");
+    let scene = scene.to_str().expect("utf-8");
+    let vol = dir.path().join("v.vol");
+    let vol = vol.to_str().expect("utf-8");
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["--out", vol, "--cells", "0"],
+            &["grid resolution", "1..=2048"],
+        ),
+        (
+            &["--out", vol, "--box", "0,500,0,100,500,100"],
+            &["box", "min < max"],
+        ),
+        (&["--out", vol, "--box", "0,1,2"], &["--box"]),
+        (
+            &["--out", &format!("{}/v.raw", dir.path().display())],
+            &["v.raw", ".vol"],
+        ),
+    ];
+    for (args, says) in cases {
+        let mut a = vec!["export", "--scene", scene];
+        a.extend(args);
+        let o = cumulus(&a);
+        let e = stderr(&o);
+        assert_ne!(o.status.code(), Some(0), "{args:?}");
+        assert!(!e.contains("panicked"), "{e}");
+        for s in says {
+            assert!(e.contains(s), "{args:?}: stderr lacks `{s}`: {e}");
+        }
+    }
+    assert!(std::fs::read_dir(dir.path()).expect("dir").next().is_none());
+}
