@@ -225,10 +225,17 @@ def main():
     ap.add_argument("--height", type=int, default=120)
     ap.add_argument("--cells", type=int, default=256)
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/cumulus"))
+    ap.add_argument("--views", default=",".join(v[0] for v in VIEWS),
+                    help="comma-separated views to run")
+    ap.add_argument("--out", default=HERE, help="where the pictures and the CSV go")
+    ap.add_argument("--cache", default=None,
+                    help="keep Mitsuba's renders here and reuse them (only while the "
+                         "scene, the density and the export stay the same)")
     a = ap.parse_args()
+    views = [v for v in VIEWS if v[0] in a.views.split(",")]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name, base, sun_el, sun_az, yaw in VIEWS:
+        for name, base, sun_el, sun_az, yaw in views:
             scene = os.path.join(ROOT, "scenes", f".gt_{name}.toml")
             scene_variant(base, sun_el, sun_az, yaw, a.width, a.height, scene)
             try:
@@ -245,7 +252,14 @@ def main():
                 os.remove(scene)
             side = json.load(open(vol[:-4] + ".json"))
             ours = read_exr(ours_path)
-            truth = mitsuba_render(vol, sky, side, a.spp, a.width, a.height)
+            key = f"{name}_{a.width}x{a.height}_{a.spp}spp_{a.cells}cells.npy"
+            cached = os.path.join(a.cache, key) if a.cache else None
+            if cached and os.path.exists(cached):
+                truth = np.load(cached)
+            else:
+                truth = mitsuba_render(vol, sky, side, a.spp, a.width, a.height)
+                if cached:
+                    np.save(cached, truth)
             eye, dirs = camera_rays(side, a.width, a.height)
             tau = optical_depth(read_vol(vol), side, eye, dirs)
             cloud = tau >= 1.0
@@ -273,11 +287,11 @@ def main():
             err_img = np.stack([err * 255, (1 - err) * 255 * cloud, np.zeros_like(err)], axis=2)
             err_img = np.where(cloud[..., None], err_img, 0).astype(np.uint8)
             strip = np.concatenate([aces(ours, exposure), aces(truth, exposure), err_img], axis=1)
-            Image.fromarray(strip).save(os.path.join(HERE, f"{name}_side_by_side.png"))
+            Image.fromarray(strip).save(os.path.join(a.out, f"{name}_side_by_side.png"))
             print(f"{name}: {n} cloud pixels, mean |rel. error| {mean_rel:.3f} "
                   f"(4x4 blocks {mean_rel_b:.3f}), bias {bias:+.3f}, "
                   f"tops ours/Mitsuba {tops:.3f}", flush=True)
-    with open(os.path.join(HERE, "ground_truth.csv"), "w", newline="") as f:
+    with open(os.path.join(a.out, "ground_truth.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
