@@ -217,10 +217,21 @@ fn export_refuses_bad_grids_boxes_and_names_before_simulating() {
     let scene = scene.to_str().expect("utf-8");
     let vol = dir.path().join("v.vol");
     let vol = vol.to_str().expect("utf-8");
-    let cases: [(&[&str], &[&str]); 4] = [
+    // `--time-s 1e7` would simulate for hours: each refusal must come
+    // before the simulation for the test to finish.
+    let cases: [(&[&str], &[&str]); 6] = [
+        (&["--out", vol, "--cells", "0"], &["--cells", "1..=2048"]),
+        (&["--out", vol, "--cells", "2048"], &["grid cells", "2^28"]),
         (
-            &["--out", vol, "--cells", "0"],
-            &["grid resolution", "1..=2048"],
+            &[
+                "--out",
+                vol,
+                "--box",
+                "0,0,0,1e5,1e5,1e5",
+                "--cells",
+                "1024",
+            ],
+            &["grid cells", "2^28"],
         ),
         (
             &["--out", vol, "--box", "0,500,0,100,500,100"],
@@ -233,7 +244,7 @@ fn export_refuses_bad_grids_boxes_and_names_before_simulating() {
         ),
     ];
     for (args, says) in cases {
-        let mut a = vec!["export", "--scene", scene];
+        let mut a = vec!["export", "--scene", scene, "--time-s", "1e7"];
         a.extend(args);
         let o = cumulus(&a);
         let e = stderr(&o);

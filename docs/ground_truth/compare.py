@@ -233,6 +233,8 @@ def main():
                          "scene, the density and the export stay the same)")
     a = ap.parse_args()
     views = [v for v in VIEWS if v[0] in a.views.split(",")]
+    if not views:
+        sys.exit(f"--views {a.views}: none of {', '.join(v[0] for v in VIEWS)}")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, base, sun_el, sun_az, yaw in views:
@@ -247,7 +249,7 @@ def main():
                 exposure = 1.2
                 for line in open(scene):
                     if line.strip().startswith("exposure"):
-                        exposure = float(line.split("=")[1])
+                        exposure = float(line.split("=")[1].split("#")[0])
             finally:
                 os.remove(scene)
             side = json.load(open(vol[:-4] + ".json"))

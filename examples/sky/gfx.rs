@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result, anyhow};
-use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings};
+use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings, is_hdr};
 use winit::window::Window;
 
 use crate::world::World;
@@ -58,7 +58,14 @@ impl Gfx {
             .get_default_config(&adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
         let caps = surface.get_capabilities(&adapter);
-        if let Some(f) = caps.formats.iter().find(|f| f.is_srgb()) {
+        // An sRGB format, else any 8-bit one: a floating-point surface
+        // would get the renderer's linear radiance, not a tone-mapped picture.
+        let pick = caps
+            .formats
+            .iter()
+            .find(|f| f.is_srgb())
+            .or_else(|| caps.formats.iter().find(|f| !is_hdr(**f)));
+        if let Some(f) = pick {
             config.format = *f;
         }
         if caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {

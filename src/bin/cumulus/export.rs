@@ -27,7 +27,7 @@ pub struct ExportArgs {
     out: PathBuf,
     /// Cells along the box's longest side (1..=2048); the other sides get
     /// as many as keep the cells nearly cubic.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=2048))]
     cells: u32,
     /// The box, metres: x0,y0,z0,x1,y1,z1 (x east, y up, z north).
     /// Default: the simulated domain across the cloud band.
@@ -63,6 +63,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     }
     let sidecar_path = a.out.with_extension("json");
     check_output_file(&a.out)?;
+    check_output_file(&sidecar_path)?;
     if let Some(sky) = &a.sky {
         let ext = sky.extension().map(|e| e.to_string_lossy().to_lowercase());
         if ext.as_deref() != Some("exr") {
@@ -76,22 +77,28 @@ pub fn run(a: ExportArgs) -> Result<()> {
             s.render.time_s = t;
         }
     })?;
-    let bar = progress_bar(Prepared::frames(&scene), "simulating");
-    let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
-    bar.finish_and_clear();
+    // The grid is checked before the simulation: the default box is the
+    // domain across the band, both known from the scene alone.
     let r = &scene.render;
-    let frame = prepared.frame(r, r.quality());
+    let density = r.density(
+        scene.band(&scene.atmosphere(None)?),
+        scene.physics.domain_size_m,
+    );
     let (min, max) = match &a.r#box {
         Some(b) => (Vec3::new(b[0], b[1], b[2]), Vec3::new(b[3], b[4], b[5])),
         None => {
-            let e = frame.density.map_extent_m;
+            let e = density.map_extent_m;
             (
-                Vec3::new(0.0, frame.density.band_bottom_m, 0.0),
-                Vec3::new(e, frame.density.band_top_m, e),
+                Vec3::new(0.0, density.band_bottom_m, 0.0),
+                Vec3::new(e, density.band_top_m, e),
             )
         }
     };
     let grid = Grid::cubic(a.cells, min, max).context("--cells and --box")?;
+    let bar = progress_bar(Prepared::frames(&scene), "simulating");
+    let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
+    bar.finish_and_clear();
+    let frame = prepared.frame(r, r.quality());
     guard_output_file(&a.out);
     guard_output_file(&sidecar_path);
     let values = volume_export::sample(&frame, &grid);

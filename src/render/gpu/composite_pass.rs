@@ -1,6 +1,7 @@
 //! The `composite` pass: the resolved cloud layer over the sky, the
 //! terrain or the application's own colour (where its depth buffer has
-//! geometry), tone-mapped into the target.
+//! geometry): tone-mapped into an 8-bit target, linear radiance into a
+//! floating-point one.
 
 use super::bind::{self, Recorder, UNFILTERABLE};
 use super::inputs::Inputs;

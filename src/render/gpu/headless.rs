@@ -147,8 +147,15 @@ impl Headless {
         ))
     }
 
-    /// The target's pixels as tightly packed RGB8 (sRGB).
+    /// The target's pixels as tightly packed RGB8 (sRGB); an error for a
+    /// [`HDR_FORMAT`] target (read it with [`Self::read_linear`]).
     pub fn read_rgb8(&self, ctx: &GpuContext) -> Result<Vec<u8>, GpuError> {
+        if self.target.format() != TARGET_FORMAT {
+            return Err(GpuError::Readback(format!(
+                "the target is {:?}, not 8-bit sRGB: read it with read_linear",
+                self.target.format()
+            )));
+        }
         let rgba = ctx.read_texture(&self.target, 4)?;
         Ok(rgba
             .chunks_exact(4)

@@ -18,6 +18,7 @@ pub mod timer;
 pub mod tsaa;
 pub mod uniforms;
 
+pub use composite_pass::is_hdr;
 pub use context::{GpuContext, GpuError};
 pub use headless::Headless;
 pub use renderer::{CloudRenderer, RenderError};

@@ -12,7 +12,8 @@
 //! 3. `tsaa` (TSAA on, [`super::tsaa`]): reprojects, clamps and blends the
 //!    history (ping-pong pair).
 //! 4. `composite` ([`super::composite_pass`]): clouds over the sky or
-//!    terrain, tone-mapped into the target.
+//!    terrain, tone-mapped into an 8-bit target (linear radiance into a
+//!    floating-point one).
 //!
 //! Every pass reads bind group 0 ([`super::inputs`]). Size-dependent
 //! targets belong to the pass that writes them and are remade on resize.
