@@ -15,6 +15,9 @@ override SHADOW_STEPS: u32 = 6u;
 override OCTAVES: u32 = 2u;
 override DETAIL: bool = true;
 override DEBUG_COUNT: bool = false;
+// The sea below the horizon (else land), and its wind speed (m/s).
+override SEA: bool = false;
+override SEA_WIND_MPS: f32 = 7.0;
 
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
@@ -37,6 +40,7 @@ const BLUE_NOISE_SIZE: u32 = 64u;
 const ALBEDO: f32 = 0.99;
 const MIN_TRANSMITTANCE: f32 = 0.01;
 const SUN_DISK_COS: f32 = 0.999989;
+const WATER_F0: f32 = 0.0204;
 // The longest shadow ray toward the sun, m.
 const SHADOW_RAY_M: f32 = 2000.0;
 // The clip depth at which rays are unprojected.
@@ -377,6 +381,45 @@ fn sky_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
         return mix(ground, horizon, f);
     }
     return sky_above(dir, sun_dir);
+}
+
+// Schlick's Fresnel reflectance of water (the CPU's `fresnel_water`).
+fn fresnel_water(cos_i: f32) -> f32 {
+    let c = 1.0 - clamp(cos_i, 0.0, 1.0);
+    return WATER_F0 + (1.0 - WATER_F0) * c * c * c * c * c;
+}
+
+// The wind-roughened sea along `dir` (pointing down): the reflected sky,
+// the sun's glint (Cox-Munk slopes, Beckmann), the water's own blue, the
+// horizon's haze (the CPU's `sea_radiance`).
+fn sea_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
+    let mu = max(-dir.y, 1e-3);
+    let f = fresnel_water(mu);
+    let reflected = sky_radiance(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+    let sun = frame.sun_light.xyz;
+    let variance = 0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0);
+    let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
+    let cos_b = max(h.y, 1e-3);
+    let cos2 = cos_b * cos_b;
+    let d = exp(-(1.0 - cos2) / (cos2 * variance)) / (PI * variance * cos2 * cos2);
+    var glint = vec3f(0.0);
+    if sun_dir.y > 0.0 {
+        glint = sun * (fresnel_water(dot(h, sun_dir)) * d / (4.0 * mu));
+    }
+    let water = vec3f(0.004, 0.012, 0.02)
+        * (sun * (max(sun_dir.y, 0.0) / PI) + sky_radiance(vec3f(0.0, 1.0, 0.0), sun_dir));
+    let surface = reflected * f + glint + water * (1.0 - f);
+    let horizon = sky_radiance(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
+    return mix(surface, horizon, exp(-mu * 40.0));
+}
+
+// The sky and the sun disk, or below the horizon the land or the sea (the
+// CPU's `background_radiance`).
+fn background_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
+    if SEA && dir.y < 0.0 {
+        return sea_radiance(dir, sun_dir);
+    }
+    return sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir);
 }
 
 fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {

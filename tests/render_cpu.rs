@@ -245,6 +245,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
             haze_distance_m: 1e9,
             max_distance_m: 1e5,
             exposure: 1.0,
+            sea_wind_mps: None,
         },
         terrain: None,
     };
@@ -277,6 +278,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
             haze_distance_m: 25_000.0,
             max_distance_m: 40_000.0,
             exposure: 1.2,
+            sea_wind_mps: None,
         },
         terrain: None,
     }

@@ -96,6 +96,24 @@ fn gpu_matches_cpu_reference_from_the_ground() {
     );
 }
 
+/// The sea (BOMEX's ground) with the sun's glint, the reflected sky and
+/// the horizon in view: the composite's `background_radiance` against the
+/// CPU's.
+#[test]
+fn gpu_matches_cpu_reference_over_the_sea() {
+    let Some(ctx) = gpu() else { return };
+    let mut sc = scene("bomex");
+    assert!(
+        sc.render.quality().sea_wind_mps.is_some(),
+        "BOMEX is over the sea"
+    );
+    sc.render.sun_elevation_deg = 30.0;
+    sc.render.sun_azimuth_deg = 180.0;
+    sc.render.camera_yaw_deg = 180.0;
+    sc.render.camera_pitch_deg = -10.0;
+    parity(&ctx, &sc, &[(96, 64)], PARITY_MEAN, PARITY_MAX);
+}
+
 #[test]
 fn gpu_matches_cpu_reference_above_and_inside_the_band() {
     let Some(ctx) = gpu() else { return };

@@ -29,7 +29,7 @@ const GPU_ONLY: &[(&str, &str)] = &[
     // glam's Vec3::normalize_or on the CPU.
     ("normalize_or", "glam's Vec3::normalize_or"),
     // The composite's background: sky_radiance + sun_disk on the CPU.
-    ("sky_background", "sky_radiance + sun_disk per pixel"),
+    ("sky_background", "background_radiance per pixel"),
     ("sky_above", "the zenith sky, precomputed in FrameUniforms"),
     // Integer wrap of texel indices (rem_euclid on the CPU).
     ("wrap_i", "i64::rem_euclid on the CPU"),
@@ -68,6 +68,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("ALBEDO", renderer::ALBEDO as f64),
         ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE as f64),
         ("SUN_DISK_COS", sky::SUN_DISK_COS as f64),
+        ("WATER_F0", sky::WATER_F0 as f64),
         ("SHADOW_RAY_M", lighting::SHADOW_RAY_M as f64),
         ("RAY_DEPTH", cumulus::render::camera::RAY_DEPTH as f64),
     ]

@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::io::write_atomically;
 use crate::render::cpu::density::density_at;
 use crate::render::cpu::renderer::{ALBEDO, Frame, SUN_INTENSITY};
-use crate::render::cpu::sky::{sky_radiance, sun_color, sun_direction};
+use crate::render::cpu::sky::{sea_radiance, sky_radiance, sun_color, sun_direction};
 
 /// The largest number of cells along one axis.
 pub const MAX_CELLS: u32 = 2048;
@@ -275,15 +275,23 @@ pub fn envmap_direction(i: u32, j: u32, width: u32, height: u32) -> Vec3 {
 }
 
 /// The renderer's sky (`sky_radiance`: the sky above the horizon, the
-/// ground seen through haze below it; no sun disk, which an offline
-/// renderer gets as a directional light) as a `width x height`
+/// ground seen through haze below it, or the scene's sea,
+/// `sea_radiance`; no sun disk, which an offline renderer gets as a
+/// directional light) as a `width x height`
 /// latitude-longitude map of linear RGB, row-major, laid out for
 /// Mitsuba 3's `envmap` ([`envmap_direction`]).
 pub fn sky_envmap(frame: &Frame, width: u32, height: u32) -> Vec<f32> {
     let sun = sun_direction(frame.sun_elevation_deg, frame.sun_azimuth_deg);
     (0..height)
         .flat_map(|j| (0..width).map(move |i| (i, j)))
-        .flat_map(|(i, j)| sky_radiance(envmap_direction(i, j, width, height), sun).to_array())
+        .flat_map(|(i, j)| {
+            let d = envmap_direction(i, j, width, height);
+            match frame.quality.sea_wind_mps {
+                Some(wind) if d.y < 0.0 => sea_radiance(d, sun, wind),
+                _ => sky_radiance(d, sun),
+            }
+            .to_array()
+        })
         .collect()
 }
 

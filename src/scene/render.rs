@@ -8,6 +8,7 @@ use crate::render::camera::Camera;
 use crate::render::cloud_map::CloudMapConfig;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::Quality;
+use crate::render::cpu::sky::GroundConfig;
 use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::TerrainConfig;
 use crate::sim::{Band, Check};
@@ -71,6 +72,9 @@ pub struct RenderSettings {
     pub cloud_map: CloudMapConfig,
     /// The terrain (`[render.terrain]`), off by default.
     pub terrain: TerrainConfig,
+    /// The ground where there is no terrain (`[render.ground]`): land by
+    /// default, or the sea.
+    pub ground: GroundConfig,
 }
 
 impl Default for RenderSettings {
@@ -100,6 +104,7 @@ impl Default for RenderSettings {
             cpu_offsets: 4,
             cloud_map: Default::default(),
             terrain: TerrainConfig::default(),
+            ground: GroundConfig::default(),
         }
     }
 }
@@ -261,6 +266,13 @@ impl RenderSettings {
                 "> 0 m",
             ),
             range("render.terrain.hills", r.terrain.hills, 1.0, 64.0, "1..=64"),
+            range(
+                "render.ground.wind_speed_mps",
+                f(r.ground.wind_speed_mps),
+                0.0,
+                30.0,
+                "0..=30 m/s",
+            ),
             Check::new(
                 "render.terrain.size",
                 (16..=2048).contains(&r.terrain.size),
@@ -330,6 +342,7 @@ impl RenderSettings {
             haze_distance_m: self.haze_distance_m,
             max_distance_m: self.max_distance_m,
             exposure: self.exposure,
+            sea_wind_mps: self.ground.sea_wind_mps(),
         }
     }
 }

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
-use super::sky::{sky_radiance, sun_color, sun_direction, sun_disk};
+use super::sky::{background_radiance, sky_radiance, sun_color, sun_direction};
 use crate::render::camera::View;
 use crate::render::sampling::{self, frame_offset, jitter};
 use crate::render::terrain::Heightfield;
@@ -29,6 +29,9 @@ pub struct Quality {
     pub max_distance_m: f32,
     /// Exposure multiplier before tone mapping.
     pub exposure: f32,
+    /// The sea below the horizon with this wind speed, m/s (`None`:
+    /// land; [`super::sky::background_radiance`]).
+    pub sea_wind_mps: Option<f32>,
 }
 
 /// Single-scattering albedo of cloud droplets.
@@ -113,7 +116,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             t,
         ),
         None => (
-            sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir),
+            background_radiance(dir, sun_dir, q.sea_wind_mps),
             q.max_distance_m,
         ),
     };

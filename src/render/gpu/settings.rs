@@ -37,6 +37,11 @@ impl GpuSettings {
             ("OCTAVES", self.quality.octaves as f64),
             ("DETAIL", flag(self.detail())),
             ("DEBUG_COUNT", flag(self.debug_sample_count)),
+            ("SEA", flag(self.quality.sea_wind_mps.is_some())),
+            (
+                "SEA_WIND_MPS",
+                self.quality.sea_wind_mps.unwrap_or_default() as f64,
+            ),
         ]
     }
 }
