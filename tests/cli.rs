@@ -825,3 +825,17 @@ fn shipped_scenes_work_outside_the_repository() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("cannot read scene"), "{}", stderr(&o));
 }
+
+#[test]
+fn a_bad_ground_names_its_key() {
+    assert_simulate_fails(
+        "[render.ground]\nsurface = \"lake\"\n",
+        None,
+        &["bad.toml", "lake", "land", "sea"],
+    );
+    assert_simulate_fails(
+        "[render.ground]\nwind_speed_mps = 50.0\n",
+        None,
+        &["bad.toml", "render.ground.wind_speed_mps", "0..=30"],
+    );
+}
