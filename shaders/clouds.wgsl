@@ -371,17 +371,53 @@ fn sky_above(dir: vec3f, sun_dir: vec3f) -> vec3f {
     return base + glow;
 }
 
+// The flat land through the haze, its sunlit part dimmed by the clouds'
+// shadow (the CPU's `land_radiance`).
+fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
+    let sun = sun_color(sun_dir);
+    let day = max(sqrt(clamp(sun_dir.y, 0.0, 1.0)), 0.15);
+    let ground = vec3f(0.10, 0.12, 0.10) * day * (0.4 + 0.6 * shadow * sun);
+    let horizon = sky_above(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
+    let f = exp(-(-dir.y) * 40.0);
+    return mix(ground, horizon, f);
+}
+
 fn sky_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
     if dir.y < 0.0 {
-        let sun = sun_color(sun_dir);
-        let day = max(sqrt(clamp(sun_dir.y, 0.0, 1.0)), 0.15);
-        let ground = vec3f(0.10, 0.12, 0.10) * day * (0.4 + 0.6 * sun);
-        let horizon = sky_above(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
-        let f = exp(-(-dir.y) * 40.0);
-        return mix(ground, horizon, f);
+        return land_radiance(dir, sun_dir, 1.0);
     }
     return sky_above(dir, sun_dir);
 }
+
+fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
+    let seg = band_segment(p, sun_dir, frame.band.x, frame.band.y, 20000.0);
+    if seg.y <= seg.x {
+        return 1.0;
+    }
+    let n = max(steps, 1u);
+    let dt = (seg.y - seg.x) / f32(n);
+    var tau = 0.0;
+    for (var i = 0u; i < n; i++) {
+        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), false, 0.0) * dt;
+    }
+    return exp(-tau);
+}
+
+// The clouds' shadow where a ray that meets no terrain reaches the flat
+// ground (the CPU's `flat_ground_shadow`).
+fn flat_ground_shadow(origin: vec3f, dir: vec3f, sun_dir: vec3f) -> f32 {
+    if dir.y >= 0.0 || origin.y <= 0.0 || SHADOW_STEPS == 0u || sun_dir.y <= 0.0 {
+        return 1.0;
+    }
+    let t = origin.y / -dir.y;
+    if t > frame.sun_light.w {
+        return 1.0;
+    }
+    let p = vec3f(origin.x + dir.x * t, 0.0, origin.z + dir.z * t);
+    return cloud_shadow(p, sun_dir, SHADOW_STEPS * 2u);
+}
+
+
 
 // Schlick's Fresnel reflectance of water (the CPU's `fresnel_water`).
 fn fresnel_water(cos_i: f32) -> f32 {
@@ -392,11 +428,11 @@ fn fresnel_water(cos_i: f32) -> f32 {
 // The wind-roughened sea along `dir` (pointing down): the reflected sky,
 // the sun's glint (Cox-Munk slopes, Beckmann), the water's own blue, the
 // horizon's haze (the CPU's `sea_radiance`).
-fn sea_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
+fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
     let mu = max(-dir.y, 1e-3);
     let f = fresnel_water(mu);
     let reflected = sky_radiance(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
-    let sun = frame.sun_light.xyz;
+    let sun = frame.sun_light.xyz * shadow;
     let variance = 0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0);
     let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
     let cos_b = max(h.y, 1e-3);
@@ -413,13 +449,16 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
     return mix(surface, horizon, exp(-mu * 40.0));
 }
 
-// The sky and the sun disk, or below the horizon the land or the sea (the
-// CPU's `background_radiance`).
-fn background_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
-    if SEA && dir.y < 0.0 {
-        return sea_radiance(dir, sun_dir);
+// The sky and the sun disk, or below the horizon the land or the sea in
+// the clouds' shadow (the CPU's `background_radiance`).
+fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
+    if dir.y >= 0.0 {
+        return sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir);
     }
-    return sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir);
+    if SEA {
+        return sea_radiance(dir, sun_dir, shadow);
+    }
+    return land_radiance(dir, sun_dir, shadow);
 }
 
 fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {

@@ -39,5 +39,5 @@ fn display(c: vec3f) -> vec3f {
 fn sky_background(pos: vec2f) -> vec3f {
     let dir = camera_ray(pos);
     let sun_dir = frame.sun_dir.xyz;
-    return background_radiance(dir, sun_dir);
+    return background_radiance(dir, sun_dir, flat_ground_shadow(frame.cam_pos.xyz, dir, sun_dir));
 }

@@ -37,20 +37,6 @@ fn normal_at(x: f32, z: f32) -> vec3f {
     return normalize(vec3f(-dx, 2.0 * e, -dz));
 }
 
-fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
-    let seg = band_segment(p, sun_dir, frame.band.x, frame.band.y, 20000.0);
-    if seg.y <= seg.x {
-        return 1.0;
-    }
-    let n = max(steps, 1u);
-    let dt = (seg.y - seg.x) / f32(n);
-    var tau = 0.0;
-    for (var i = 0u; i < n; i++) {
-        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), false, 0.0) * dt;
-    }
-    return exp(-tau);
-}
-
 fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let n = normal_at(p.x, p.z);
     let slope = 1.0 - n.y;

@@ -116,7 +116,12 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             t,
         ),
         None => (
-            background_radiance(dir, sun_dir, q.sea_wind_mps),
+            background_radiance(
+                dir,
+                sun_dir,
+                q.sea_wind_mps,
+                flat_ground_shadow(origin, dir, sun_dir, fr),
+            ),
             q.max_distance_m,
         ),
     };
@@ -227,6 +232,23 @@ pub fn terrain_radiance(
     let haze = (-t / fr.quality.haze_distance_m.max(1.0)).exp();
     let horizon = sky_radiance(Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X), sun_dir);
     lit * haze + horizon * (1.0 - haze)
+}
+
+/// The clouds' shadow where a ray that meets no terrain reaches the flat
+/// ground (y = 0; land or sea): [`cloud_shadow`] there with the terrain's
+/// `2 · shadow_steps` samples, 1 without shadows, with the sun down, for a
+/// ray that does not reach the ground within `max_distance_m`.
+pub fn flat_ground_shadow(origin: Vec3, dir: Vec3, sun_dir: Vec3, fr: &Frame) -> f32 {
+    let q = &fr.quality;
+    if dir.y >= 0.0 || origin.y <= 0.0 || q.shadow_steps == 0 || sun_dir.y <= 0.0 {
+        return 1.0;
+    }
+    let t = origin.y / -dir.y;
+    if t > q.max_distance_m {
+        return 1.0;
+    }
+    let p = Vec3::new(origin.x + dir.x * t, 0.0, origin.z + dir.z * t);
+    cloud_shadow(p, sun_dir, q.shadow_steps * 2, &fr.fields, &fr.density)
 }
 
 /// Transmittance of the cloud band from a ground point `p` toward the sun:

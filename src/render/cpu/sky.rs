@@ -28,11 +28,7 @@ pub fn sky_radiance(dir: Vec3, sun_dir: Vec3) -> Vec3 {
     let sun = sun_color(sun_dir);
     let day = sun_dir.y.clamp(0.0, 1.0).sqrt().max(0.15);
     if dir.y < 0.0 {
-        // Ground seen through haze.
-        let ground = Vec3::new(0.10, 0.12, 0.10) * day * (0.4 + 0.6 * sun);
-        let horizon = sky_radiance(Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X), sun_dir);
-        let f = (-(-dir.y) * 40.0).exp();
-        return ground.lerp(horizon, f);
+        return land_radiance(dir, sun_dir, 1.0);
     }
     let zenith = Vec3::new(0.16, 0.32, 0.75);
     let horizon = Vec3::new(0.62, 0.72, 0.86);
@@ -41,6 +37,19 @@ pub fn sky_radiance(dir: Vec3, sun_dir: Vec3) -> Vec3 {
     let cos = dir.dot(sun_dir);
     let glow = sun * (phase_hg(cos, 0.76) * 0.35);
     base + glow
+}
+
+/// The flat land seen along `dir` (pointing down) through the haze: a dim
+/// green-grey lit by the sky and by the sun, whose part is dimmed by the
+/// clouds' `shadow` (the transmittance toward the sun, 1: in the sun).
+#[inline]
+pub fn land_radiance(dir: Vec3, sun_dir: Vec3, shadow: f32) -> Vec3 {
+    let sun = sun_color(sun_dir);
+    let day = sun_dir.y.clamp(0.0, 1.0).sqrt().max(0.15);
+    let ground = Vec3::new(0.10, 0.12, 0.10) * day * (0.4 + 0.6 * shadow * sun);
+    let horizon = sky_radiance(Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X), sun_dir);
+    let f = (-(-dir.y) * 40.0).exp();
+    ground.lerp(horizon, f)
 }
 
 /// The sun disk's radiance along `dir` (0 off the disk).
@@ -122,14 +131,15 @@ pub fn fresnel_water(cos_i: f32) -> f32 {
 /// - the water's own light: a deep-blue albedo (0.004, 0.012, 0.02) lit
 ///   by the sun and the zenith sky, through the surface (1 - F);
 ///
-/// then faded into the horizon's haze as the land is ([`sky_radiance`]).
-/// Clouds are not reflected and cast no shadow on it.
+/// then faded into the horizon's haze as the land is ([`land_radiance`]).
+/// The clouds' `shadow` (transmittance toward the sun) dims the glint and
+/// the sunlit part of the water; clouds are not reflected.
 #[inline]
-pub fn sea_radiance(dir: Vec3, sun_dir: Vec3, wind_mps: f32) -> Vec3 {
+pub fn sea_radiance(dir: Vec3, sun_dir: Vec3, wind_mps: f32, shadow: f32) -> Vec3 {
     let mu = (-dir.y).max(1e-3);
     let f = fresnel_water(mu);
     let reflected = sky_radiance(Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y), sun_dir);
-    let sun = sun_color(sun_dir) * SUN_INTENSITY;
+    let sun = sun_color(sun_dir) * SUN_INTENSITY * shadow;
     let variance = 0.003 + 0.00512 * wind_mps.max(0.0);
     let h = (sun_dir - dir).normalize_or(Vec3::Y);
     let cos_b = h.y.max(1e-3);
@@ -149,13 +159,22 @@ pub fn sea_radiance(dir: Vec3, sun_dir: Vec3, wind_mps: f32) -> Vec3 {
 }
 
 /// What a ray that meets no terrain sees along `dir`: the sky and the sun
-/// disk, or below the horizon the ground (land: [`sky_radiance`]) or, with
-/// `sea_wind_mps`, the sea ([`sea_radiance`]).
+/// disk, or below the horizon the land ([`land_radiance`]) or, with
+/// `sea_wind_mps`, the sea ([`sea_radiance`]), in the clouds' `shadow`
+/// where the ray meets them.
 #[inline]
-pub fn background_radiance(dir: Vec3, sun_dir: Vec3, sea_wind_mps: Option<f32>) -> Vec3 {
+pub fn background_radiance(
+    dir: Vec3,
+    sun_dir: Vec3,
+    sea_wind_mps: Option<f32>,
+    shadow: f32,
+) -> Vec3 {
+    if dir.y >= 0.0 {
+        return sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir);
+    }
     match sea_wind_mps {
-        Some(wind) if dir.y < 0.0 => sea_radiance(dir, sun_dir, wind),
-        _ => sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir),
+        Some(wind) => sea_radiance(dir, sun_dir, wind, shadow),
+        None => land_radiance(dir, sun_dir, shadow),
     }
 }
 
@@ -185,7 +204,7 @@ mod tests {
         let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
         let at = |elev_deg: f32, az_deg: f32, wind: f32| {
             let d = -sun_direction(elev_deg, az_deg) * Vec3::new(-1.0, 1.0, -1.0);
-            sea_radiance(d.normalize(), sun, wind)
+            sea_radiance(d.normalize(), sun, wind, 1.0)
         };
         // Away from the sun (azimuth 0), straight down and near the horizon.
         let down = lum(at(80.0, 0.0, 7.0));
@@ -203,16 +222,23 @@ mod tests {
         );
         let rough = lum(at(30.0, 180.0, 20.0));
         assert!(rough < glint && lum(at(30.0, 160.0, 20.0)) > lum(at(30.0, 160.0, 7.0)));
-        // The background picks the sea below the horizon only.
+        // The background picks the sea below the horizon only, and a
+        // cloud's shadow dims the glint.
         let up = Vec3::new(0.0, 0.5, 0.866);
         assert_eq!(
-            background_radiance(up, sun, Some(7.0)),
-            background_radiance(up, sun, None)
+            background_radiance(up, sun, Some(7.0), 0.0),
+            background_radiance(up, sun, None, 1.0)
         );
         let d = Vec3::new(0.0, -0.5, 0.866);
         assert_ne!(
-            background_radiance(d, sun, Some(7.0)),
-            background_radiance(d, sun, None)
+            background_radiance(d, sun, Some(7.0), 1.0),
+            background_radiance(d, sun, None, 1.0)
         );
+        let g = -sun * Vec3::new(-1.0, 1.0, -1.0);
+        let shaded = lum(sea_radiance(g, sun, 7.0, 0.1));
+        assert!(shaded < 0.2 * glint, "{shaded} {glint}");
+        // The land in a cloud's shadow is darker, by the sun's part.
+        let (lit, dark) = (land_radiance(d, sun, 1.0), land_radiance(d, sun, 0.0));
+        assert!(lum(dark) < 0.8 * lum(lit) && lum(dark) > 0.2 * lum(lit));
     }
 }
