@@ -9,8 +9,8 @@ mod common;
 use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::View;
-use cumulus::render::cpu::renderer::{render_clouds_linear, to_srgb8};
-use cumulus::render::cpu::sky::{sky_radiance, sun_direction, sun_disk};
+use cumulus::render::cpu::renderer::{flat_ground_shadow, render_clouds_linear, to_srgb8};
+use cumulus::render::cpu::sky::{background_radiance, sun_direction};
 use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, textures};
 use cumulus::scene::Scene;
@@ -257,7 +257,8 @@ fn every_depth_convention_hides_the_same_clouds() {
 }
 
 /// The clouds-only layer composited over the analytic sky on the CPU
-/// (`rgb + (1 - a) · sky`, tone-mapped) is the renderer's own composite:
+/// (`rgb + (1 - a) · sky`, the ground in the clouds' shadows below the
+/// horizon, tone-mapped) is the renderer's own composite:
 /// the output is linear, premultiplied, and leaves the background out.
 #[test]
 fn the_clouds_only_layer_composites_to_the_renderers_picture() {
@@ -293,13 +294,16 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
     let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
+    let q = r.quality();
+    let frame = p.frame(r, q);
     let composited: Vec<Vec3> = layer
         .iter()
         .enumerate()
         .map(|(k, px)| {
             let (x, y) = ((k as u32 % W) as f32 + 0.5, (k as u32 / W) as f32 + 0.5);
             let dir = view.camera_ray(x, y, W, H);
-            let sky = sky_radiance(dir, sun) + sun_disk(dir, sun);
+            let shadow = flat_ground_shadow(view.eye(), dir, sun, &frame);
+            let sky = background_radiance(dir, sun, q.sea_wind_mps, shadow);
             Vec3::new(px[0], px[1], px[2]) + (1.0 - px[3]) * sky
         })
         .collect();
