@@ -571,7 +571,8 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     var tb = t0;
     // The lit sub-sample whose light is still to be added, and its shadow
     // ray: steps taken (SHADOW_STEPS: done), length, distance, optical
-    // depth so far.
+    // depth so far (the whole ray's once it is done, when the light is
+    // added).
     var lit = false;
     var lit_t = 0.0;
     var lit_p = vec3f(0.0);
@@ -581,7 +582,6 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     var shadow_length = 0.0;
     var shadow_t = 0.0;
     var tau = 0.0;
-    var tau_sun = 0.0;
     loop {
         // What this iteration reads: the lit sample's next shadow step,
         // else (its light added first) the next sub-sample or interval end.
@@ -599,16 +599,13 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 kind = 2u;
                 q_footprint = lit_footprint;
             }
-            if k == SHADOW_STEPS {
-                tau_sun = tau;
-            }
         }
         if kind != 2u {
             if lit {
                 lit = false;
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
                 let ambient = ambient_top * (0.35 + 0.65 * eta);
-                let scatter = sun * sun_scattering(tau_sun, cos_theta) + ambient;
+                let scatter = sun * sun_scattering(tau, cos_theta) + ambient;
                 let s = scatter * (lit_sigma * ALBEDO);
                 let step_t = exp(-lit_sigma * h);
                 light += integrate_step(s, lit_sigma, h) * transmittance;
@@ -638,9 +635,6 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
             tau += sigma * dt;
             shadow_t += dt;
             k += 1u;
-            if k == SHADOW_STEPS {
-                tau_sun = tau;
-            }
         } else if kind == 0u {
             let touched = sigma_a > 0.0 || sigma > 0.0;
             sigma_a = sigma;
@@ -663,7 +657,6 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 lit_footprint = q_footprint;
                 lit_sigma = sigma;
                 tau = 0.0;
-                tau_sun = 0.0;
                 shadow_t = 0.0;
                 shadow_length = shadow_ray_length(q, sun_dir);
                 k = 0u;

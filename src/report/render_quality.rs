@@ -44,10 +44,6 @@ pub struct Report {
     pub chosen: Option<usize>,
 }
 
-fn tone(c: Vec3, exposure: f32) -> Vec3 {
-    tone_map(c, exposure)
-}
-
 /// Renders `frame` at every count in `steps` and at the reference.
 pub fn measure(
     frame: &Frame,
@@ -63,7 +59,7 @@ pub fn measure(
     let start = Instant::now();
     let reference: Vec<Vec3> = render_linear(width, height, &reference_frame)
         .into_iter()
-        .map(|c| tone(c, exposure))
+        .map(|c| tone_map(c, exposure))
         .collect();
     let reference_wall_s = start.elapsed().as_secs_f64();
     progress();
@@ -76,7 +72,7 @@ pub fn measure(
         let wall_s = start.elapsed().as_secs_f64();
         let (mut sum, mut max) = (0.0_f64, 0.0_f32);
         for (a, b) in img.iter().zip(&reference) {
-            let e = (tone(*a, exposure) - *b).abs();
+            let e = (tone_map(*a, exposure) - *b).abs();
             sum += ((e.x + e.y + e.z) / 3.0) as f64;
             max = max.max(e.max_element());
         }

@@ -10,7 +10,9 @@ use glam::Vec3;
 use cumulus::prepare::Prepared;
 use cumulus::report::volume_export::{self, Grid, Sidecar};
 
-use crate::{check_output_file, guard_output_file, load_scene, progress_bar, with_overrides};
+use crate::{
+    check_output_file, guard_output_file, load_scene, progress_bar, with_overrides, write_exr,
+};
 
 #[derive(clap::Args)]
 #[command(
@@ -108,10 +110,8 @@ pub fn run(a: ExportArgs) -> Result<()> {
     if let Some(sky) = &a.sky {
         let (w, h) = (512, 256);
         let rgb = volume_export::sky_envmap(&frame, w, h);
-        let img = image::Rgb32FImage::from_raw(w, h, rgb).context("sky map size")?;
         guard_output_file(sky);
-        cumulus::io::write_exr_atomically(sky, &img)
-            .with_context(|| format!("{}: cannot write the sky map", sky.display()))?;
+        write_exr(sky, w, h, rgb)?;
         println!("wrote {}", sky.display());
     }
     let cloudy = values.iter().filter(|&&v| v > 0.0).count();

@@ -257,6 +257,14 @@ fn guard_output_file(path: &Path) {
     }
 }
 
+/// Writes linear RGB radiance (`rgb`, row-major, `width x height`) as
+/// OpenEXR, atomically (`render --out x.exr`, `export --sky`).
+fn write_exr(out: &Path, width: u32, height: u32, rgb: Vec<f32>) -> Result<()> {
+    let img = image::Rgb32FImage::from_raw(width, height, rgb).context("image buffer size")?;
+    cumulus::io::write_exr_atomically(out, &img)
+        .with_context(|| format!("{}: cannot write image", out.display()))
+}
+
 /// Fails early, before any simulation, when `path` cannot be written: it is
 /// a directory, or its folder does not exist.
 fn check_output_file(path: &Path) -> Result<()> {

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use cumulus::io::{write_exr_atomically, write_png_atomically};
+use cumulus::io::write_png_atomically;
 use cumulus::prepare::Prepared;
 use cumulus::render::gpu::GpuContext;
 use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
@@ -13,7 +13,7 @@ use cumulus::scene::Scene;
 
 use crate::{
     check_output_file, gpu_context, guard_output_dir, guard_output_file, load_scene, progress_bar,
-    with_overrides,
+    with_overrides, write_exr,
 };
 
 #[derive(clap::Args)]
@@ -87,13 +87,6 @@ impl Picture {
     }
 }
 
-/// Writes linear RGB radiance (`rgb`, row-major) as OpenEXR.
-fn write_exr(out: &Path, width: u32, height: u32, rgb: Vec<f32>) -> Result<()> {
-    let img = image::Rgb32FImage::from_raw(width, height, rgb).context("image buffer size")?;
-    write_exr_atomically(out, &img)
-        .with_context(|| format!("{}: cannot write image", out.display()))
-}
-
 /// Which renderer draws the image.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Backend {
@@ -127,9 +120,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
             r.steps = steps;
         }
     })?;
+    let mut picture = None;
     if let Some(out) = &a.out {
         check_output_file(out)?;
-        Picture::of(out)?;
+        picture = Some(Picture::of(out)?);
         guard_output_file(out);
     }
     let gpu = match a.backend {
@@ -215,14 +209,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
         );
     }
     if let Some(ctx) = &gpu {
-        return render_gpu(ctx, &a, &scene, &prepared);
+        return render_gpu(ctx, &a, &scene, &prepared, picture);
     }
     let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
     let linear = render_linear_offsets(r.width, r.height, &frame, r.cpu_offsets);
     let elapsed = start.elapsed();
 
-    if Picture::of(out)? == Picture::Exr {
+    if picture == Some(Picture::Exr) {
         let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
         write_exr(out, r.width, r.height, rgb)?;
     } else {
@@ -250,11 +244,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
 
 /// `render` on the GPU: `--frames` frames (TSAA converges), the last one
 /// saved; `--time-frames` times more.
-fn render_gpu(ctx: &GpuContext, a: &RenderArgs, scene: &Scene, prepared: &Prepared) -> Result<()> {
+fn render_gpu(
+    ctx: &GpuContext,
+    a: &RenderArgs,
+    scene: &Scene,
+    prepared: &Prepared,
+    picture: Option<Picture>,
+) -> Result<()> {
     let r = &scene.render;
     eprintln!("backend: gpu ({})", ctx.describe());
     let settings = prepared.gpu_settings(r, r.quality());
-    let picture = a.out.as_deref().map(Picture::of).transpose()?;
     let format = match picture {
         Some(Picture::Exr) => HDR_FORMAT,
         _ => TARGET_FORMAT,
