@@ -132,8 +132,8 @@ fn march_spheres(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
         }
         let tau_sun = sphere_optical_depth(p, sun_dir);
         let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let ambient = frame.ambient_top.xyz * (0.35 + 0.65 * eta);
-        let s = (frame.sun_light.xyz * sun_scattering(tau_sun, cos_theta) + ambient) * (sigma_t * ALBEDO);
+        let ambient = frame.ambient_top.xyz * (AMBIENT_GAIN * (0.35 + 0.65 * eta));
+        let s = (frame.sun_light.xyz * sun_scattering(tau_sun, cos_theta, frame.sun_dir.y) + ambient) * (sigma_t * ALBEDO);
         let step_t = exp(-sigma_t * dt);
         light += integrate_step(s, sigma_t, dt) * transmittance;
         depth_weighted += t * transmittance * (1.0 - step_t);

@@ -11,8 +11,8 @@
 
 // Pipeline-overridable constants: features that are off are folded away
 // by the shader compiler, so they cost nothing.
-override SHADOW_STEPS: u32 = 6u;
-override OCTAVES: u32 = 2u;
+override SHADOW_STEPS: u32 = 20u;
+override OCTAVES: u32 = 3u;
 override DETAIL: bool = true;
 override DEBUG_COUNT: bool = false;
 // The sea below the horizon (else land), and its wind speed (m/s).
@@ -43,6 +43,15 @@ const SUN_DISK_COS: f32 = 0.999989;
 const WATER_F0: f32 = 0.0204;
 // The longest shadow ray toward the sun, m.
 const SHADOW_RAY_M: f32 = 2000.0;
+// Multiple scattering and sky light (the CPU's lighting.rs, renderer.rs).
+const OCTAVE_SCATTERING: f32 = 0.67;
+const OCTAVE_EXTINCTION: f32 = 0.32;
+const OCTAVE_ECCENTRICITY: f32 = 0.55;
+const MULTIPLE_GAIN: f32 = 1.1;
+const MULTIPLE_SUN_POWER: f32 = 0.4;
+const AMBIENT_GAIN: f32 = 1.4;
+// Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
+const GROUND_SHADOW_STEPS: u32 = 12u;
 // The clip depth at which rays are unprojected.
 const RAY_DEPTH: f32 = 0.5;
 
@@ -317,10 +326,20 @@ fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
         + 0.25 * phase_hg(cos_theta, -0.3 * eccentricity);
 }
 
+// The sum of the shadow ray's step weights, √1 + √2 + ... + √steps (the
+// CPU's `shadow_parts`).
+fn shadow_parts(steps: u32) -> f32 {
+    var parts = 0.0;
+    for (var k = 1u; k <= steps; k++) {
+        parts += sqrt(f32(k));
+    }
+    return parts;
+}
+
 // The length of the shadow ray from p toward the sun: to the band's top,
 // at most SHADOW_RAY_M (the CPU's `shadow_ray_length`). The march takes
-// its SHADOW_STEPS steps of growing length (1, 2, 3, ... parts) itself,
-// as the CPU's `sun_optical_depth` does.
+// its SHADOW_STEPS steps of growing length (√1, √2, √3, ... parts of
+// shadow_parts) itself, as the CPU's `sun_optical_depth` does.
 fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
     var to_top = SHADOW_RAY_M;
     if sun_dir.y > 1e-3 {
@@ -329,12 +348,19 @@ fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
     return min(to_top, SHADOW_RAY_M);
 }
 
-fn sun_scattering(tau_sun: f32, cos_theta: f32) -> f32 {
-    var sum = 0.0;
+// Single scattering and OCTAVES octaves of multiple scattering (the CPU's
+// `sun_scattering`; constants fitted to the path tracer, docs/ground_truth).
+fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32) -> f32 {
+    var sum = phase_dual(cos_theta, 1.0) * exp(-tau_sun);
+    let gain = MULTIPLE_GAIN * pow(max(mu_sun, 0.0), MULTIPLE_SUN_POWER);
     var a = 1.0;
-    for (var i = 0u; i <= OCTAVES; i++) {
-        sum += a * phase_dual(cos_theta, a) * exp(-a * tau_sun);
-        a *= 0.5;
+    var b = 1.0;
+    var c = 1.0;
+    for (var i = 0u; i < OCTAVES; i++) {
+        a *= OCTAVE_SCATTERING;
+        b *= OCTAVE_EXTINCTION;
+        c *= OCTAVE_ECCENTRICITY;
+        sum += gain * a * phase_dual(cos_theta, c) * exp(-b * tau_sun);
     }
     return sum;
 }
@@ -398,7 +424,7 @@ fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
     let dt = (seg.y - seg.x) / f32(n);
     var tau = 0.0;
     for (var i = 0u; i < n; i++) {
-        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), false, 0.0) * dt;
+        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), true, 0.0) * dt;
     }
     return exp(-tau);
 }
@@ -414,7 +440,7 @@ fn flat_ground_shadow(origin: vec3f, dir: vec3f, sun_dir: vec3f) -> f32 {
         return 1.0;
     }
     let p = vec3f(origin.x + dir.x * t, 0.0, origin.z + dir.z * t);
-    return cloud_shadow(p, sun_dir, SHADOW_STEPS * 2u);
+    return cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);
 }
 
 
@@ -553,7 +579,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let sun = frame.sun_light.xyz;
     let ambient_top = frame.ambient_top.xyz;
     let cos_theta = dot(dir, sun_dir);
-    let parts = f32(SHADOW_STEPS * (SHADOW_STEPS + 1u) / 2u);
+    let parts = shadow_parts(SHADOW_STEPS);
     var transmittance = 1.0;
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
@@ -591,7 +617,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
         var kind = 0u; // 0: interval end, 1: sub-sample, 2: shadow step
         var t = 0.0;
         if k < SHADOW_STEPS {
-            dt = shadow_length * f32(k + 1u) / parts;
+            dt = shadow_length * sqrt(f32(k + 1u)) / parts;
             q = lit_p + sun_dir * (shadow_t + 0.5 * dt);
             if height_fraction(q.y) > 1.0 {
                 k = SHADOW_STEPS;
@@ -604,8 +630,8 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
             if lit {
                 lit = false;
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-                let ambient = ambient_top * (0.35 + 0.65 * eta);
-                let scatter = sun * sun_scattering(tau, cos_theta) + ambient;
+                let ambient = ambient_top * (AMBIENT_GAIN * (0.35 + 0.65 * eta));
+                let scatter = sun * sun_scattering(tau, cos_theta, sun_dir.y) + ambient;
                 let s = scatter * (lit_sigma * ALBEDO);
                 let step_t = exp(-lit_sigma * h);
                 light += integrate_step(s, lit_sigma, h) * transmittance;
@@ -629,7 +655,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 q_footprint = spread * t;
             }
         }
-        let sigma = density_at(q, kind != 2u, q_footprint);
+        let sigma = density_at(q, true, q_footprint);
         samples += 1u;
         if kind == 2u {
             tau += sigma * dt;

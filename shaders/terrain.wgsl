@@ -43,7 +43,7 @@ fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let albedo = mix(vec3f(0.07, 0.11, 0.04), vec3f(0.16, 0.13, 0.09), min(slope * 3.0, 1.0));
     var shadow = 1.0;
     if SHADOW_STEPS > 0u && sun_dir.y > 0.0 {
-        shadow = cloud_shadow(p, sun_dir, SHADOW_STEPS * 2u);
+        shadow = cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);
     }
     let sun = frame.sun_light.xyz;
     let sky = frame.sky_up.xyz;

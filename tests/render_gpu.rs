@@ -51,8 +51,19 @@ const PARITY_MAX: f64 = 0.6;
 /// GPU against CPU, the fraction of channels that differ by more than 0.05
 /// (measured: at most 3 of 18,432).
 const PARITY_OUTLIERS: f64 = 0.002;
+/// The same over terrain (measured on lavapipe: 137 of 18,432 on the
+/// evening view, 0.74 %, once the clouds' shadows on the ground read the
+/// detail noise; the mean stayed 0.0015).
+const PARITY_OUTLIERS_TERRAIN: f64 = 0.012;
 
-fn parity(ctx: &GpuContext, sc: &Scene, sizes: &[(u32, u32)], mean_bound: f64, max_bound: f64) {
+fn parity(
+    ctx: &GpuContext,
+    sc: &Scene,
+    sizes: &[(u32, u32)],
+    mean_bound: f64,
+    max_bound: f64,
+    outlier_bound: f64,
+) {
     let mut sc = sc.clone();
     sc.render.tsaa = false;
     let prepared = Prepared::from_scene(&sc, || {}).expect("prepare");
@@ -79,7 +90,7 @@ fn parity(ctx: &GpuContext, sc: &Scene, sizes: &[(u32, u32)], mean_bound: f64, m
         assert!(mean <= mean_bound, "{w}x{h}: mean {mean} > {mean_bound}");
         let outliers = over as f64 / cpu.len() as f64;
         assert!(
-            outliers <= PARITY_OUTLIERS,
+            outliers <= outlier_bound,
             "{w}x{h}: {outliers} of channels off by > 0.05"
         );
         assert!(max <= max_bound, "{w}x{h}: max {max} > {max_bound}");
@@ -95,6 +106,7 @@ fn gpu_matches_cpu_reference_from_the_ground() {
         &[(64, 48), (97, 61), (160, 120)],
         PARITY_MEAN,
         PARITY_MAX,
+        PARITY_OUTLIERS,
     );
 }
 
@@ -113,7 +125,7 @@ fn gpu_matches_cpu_reference_over_the_sea() {
     sc.render.sun_azimuth_deg = 180.0;
     sc.render.camera_yaw_deg = 180.0;
     sc.render.camera_pitch_deg = -10.0;
-    parity(&ctx, &sc, &[(96, 64)], PARITY_MEAN, PARITY_MAX);
+    parity(&ctx, &sc, &[(96, 64)], PARITY_MEAN, PARITY_MAX, PARITY_OUTLIERS);
 }
 
 #[test]
@@ -121,25 +133,35 @@ fn gpu_matches_cpu_reference_above_and_inside_the_band() {
     let Some(ctx) = gpu() else { return };
     // strong_inversion looks down on the layer from above.
     let above = scene("strong_inversion");
-    parity(&ctx, &above, &[(96, 64)], PARITY_MEAN, PARITY_MAX);
+    parity(&ctx, &above, &[(96, 64)], PARITY_MEAN, PARITY_MAX, PARITY_OUTLIERS);
     // Flying through the clouds: the camera in the middle of the band.
     let mut inside = scene("fair_weather");
     let atm = inside.atmosphere(None).expect("atmosphere");
     let band = inside.band(&atm);
     inside.render.camera_position_m = [0.0, (0.5 * (band.bottom_m + band.top_m)) as f32, 0.0];
     inside.render.camera_pitch_deg = 0.0;
-    parity(&ctx, &inside, &[(96, 64)], PARITY_MEAN, PARITY_MAX);
+    parity(&ctx, &inside, &[(96, 64)], PARITY_MEAN, PARITY_MAX, PARITY_OUTLIERS);
 }
 
 /// With terrain, the GPU rasterises the heightfield as triangles where the
 /// CPU marches the bilinear surface, so silhouettes of hills move by up to
-/// a pixel; the bound on the mean is twice the sky-only one.
+/// a pixel; the bound on the mean is twice the sky-only one. The ground's
+/// point moves with them, and its shadow ray through the detail noise
+/// crosses the shadows' fine edges elsewhere: [`PARITY_OUTLIERS_TERRAIN`].
+/// Flat ground, hit at the same point by both, keeps [`PARITY_OUTLIERS`].
 #[test]
 fn gpu_matches_cpu_reference_with_terrain() {
     let Some(ctx) = gpu() else { return };
     let mut sc = scene("evening");
     sc.render.terrain.size = 64;
-    parity(&ctx, &sc, &[(96, 64)], 2.0 * PARITY_MEAN, 0.5);
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        2.0 * PARITY_MEAN,
+        0.5,
+        PARITY_OUTLIERS_TERRAIN,
+    );
 }
 
 #[test]

@@ -69,6 +69,8 @@ def scene_variant(base, sun_el, sun_az, yaw, width, height, path):
         "sun_azimuth_deg": str(sun_az),
         "width": str(width),
         "height": str(height),
+        # The path tracer's scene has no air: no haze on ours either.
+        "haze_distance_m": "1e7",
     }
     out, in_render = [], False
     for line in text.splitlines():

@@ -55,7 +55,7 @@ pub fn measure(
     let exposure = frame.quality.exposure;
     let mut reference_frame = *frame;
     reference_frame.quality.steps = REFERENCE_STEPS;
-    reference_frame.quality.shadow_steps = frame.quality.shadow_steps.max(32);
+    reference_frame.quality.shadow_steps = frame.quality.shadow_steps.max(48);
     let start = Instant::now();
     let reference: Vec<Vec3> = render_linear(width, height, &reference_frame)
         .into_iter()

@@ -98,6 +98,13 @@ pub const REFINE: u32 = 4;
 /// illuminance on a clear day, so a sunlit cloud is brighter than the sky.
 pub const SUN_INTENSITY: f32 = 8.0;
 
+/// The gain on the sky's light in cloud (`AMBIENT_GAIN` in WGSL):
+/// isotropic scattering of the upper sky's irradiance (`sky_radiance(up) /
+/// 4`), 0.35 of it at the band's bottom and all of it at its top, times
+/// this, which stands for the sky light's own multiple scattering; fitted
+/// with the octaves ([`super::lighting::sun_scattering`]).
+pub const AMBIENT_GAIN: f32 = 1.4;
+
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
 /// in `[0, 1)` places the samples within their steps (0.5: centres);
 /// `spread` is the pixel's cone angle (radians, [`View::pixel_spread`]):
@@ -171,8 +178,8 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, footprint, &fr.fields, d);
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
             // Sky light from above, darker toward the cloud base.
-            let ambient = ambient_top * (0.35 + 0.65 * eta);
-            let scatter = sun * sun_scattering(tau_sun, cos, q.octaves) + ambient;
+            let ambient = ambient_top * (AMBIENT_GAIN * (0.35 + 0.65 * eta));
+            let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, q.octaves) + ambient;
             let s = scatter * (sigma_t * ALBEDO);
             let step_t = (-sigma_t * h).exp();
             light += integrate_step(s, sigma_t, h) * transmittance;
@@ -220,7 +227,7 @@ pub fn terrain_radiance(
     let albedo =
         Vec3::new(0.07, 0.11, 0.04).lerp(Vec3::new(0.16, 0.13, 0.09), (slope * 3.0).min(1.0));
     let shadow = if fr.quality.shadow_steps > 0 && sun_dir.y > 0.0 {
-        cloud_shadow(p, sun_dir, fr.quality.shadow_steps * 2, &fr.fields, d)
+        cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS, &fr.fields, d)
     } else {
         1.0
     };
@@ -236,7 +243,7 @@ pub fn terrain_radiance(
 
 /// The clouds' shadow where a ray that meets no terrain reaches the flat
 /// ground (y = 0; land or sea): [`cloud_shadow`] there with the terrain's
-/// `2 · shadow_steps` samples, 1 without shadows, with the sun down, for a
+/// [`GROUND_SHADOW_STEPS`] samples, 1 without shadows, with the sun down, for a
 /// ray that does not reach the ground within `max_distance_m`.
 pub fn flat_ground_shadow(origin: Vec3, dir: Vec3, sun_dir: Vec3, fr: &Frame) -> f32 {
     let q = &fr.quality;
@@ -248,18 +255,26 @@ pub fn flat_ground_shadow(origin: Vec3, dir: Vec3, sun_dir: Vec3, fr: &Frame) ->
         return 1.0;
     }
     let p = Vec3::new(origin.x + dir.x * t, 0.0, origin.z + dir.z * t);
-    cloud_shadow(p, sun_dir, q.shadow_steps * 2, &fr.fields, &fr.density)
+    cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS, &fr.fields, &fr.density)
 }
 
+/// Samples of the clouds' shadow on the ground, terrain or flat
+/// (`GROUND_SHADOW_STEPS` in WGSL): one ray across the band per ground
+/// pixel, whatever `shadow_steps` the clouds' own light takes.
+pub const GROUND_SHADOW_STEPS: u32 = 12;
+
 /// Transmittance of the cloud band from a ground point `p` toward the sun:
-/// `steps` samples across the band segment of the sun ray.
+/// `steps` samples across the band segment of the sun ray, reading the
+/// detail noise as the clouds' own shadow rays do (without it the field
+/// near the base is wider than the cloud, and the shadows were large dark
+/// patches).
 pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
     let Some((t0, t1)) = band_segment(p, sun_dir, d.band_bottom_m, d.band_top_m, 20_000.0) else {
         return 1.0;
     };
     let dt = (t1 - t0) / steps.max(1) as f32;
     let tau: f32 = (0..steps.max(1))
-        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d, false, 0.0) * dt)
+        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d, true, 0.0) * dt)
         .sum();
     (-tau).exp()
 }

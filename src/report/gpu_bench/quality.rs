@@ -58,9 +58,9 @@ pub(super) fn quality_sweep(
         ),
         (
             "shadow_steps",
-            vec![0, 2, 4, 6, 8, 12],
+            vec![0, 4, 8, 12, 16, 20],
             d.shadow_steps,
-            32,
+            48,
             |r, v| r.shadow_steps = v,
         ),
         ("octaves", vec![0, 1, 2, 3], d.octaves, 3, |r, v| {
