@@ -125,7 +125,14 @@ fn gpu_matches_cpu_reference_over_the_sea() {
     sc.render.sun_azimuth_deg = 180.0;
     sc.render.camera_yaw_deg = 180.0;
     sc.render.camera_pitch_deg = -10.0;
-    parity(&ctx, &sc, &[(96, 64)], PARITY_MEAN, PARITY_MAX, PARITY_OUTLIERS);
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
 }
 
 #[test]
@@ -133,14 +140,28 @@ fn gpu_matches_cpu_reference_above_and_inside_the_band() {
     let Some(ctx) = gpu() else { return };
     // strong_inversion looks down on the layer from above.
     let above = scene("strong_inversion");
-    parity(&ctx, &above, &[(96, 64)], PARITY_MEAN, PARITY_MAX, PARITY_OUTLIERS);
+    parity(
+        &ctx,
+        &above,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
     // Flying through the clouds: the camera in the middle of the band.
     let mut inside = scene("fair_weather");
     let atm = inside.atmosphere(None).expect("atmosphere");
     let band = inside.band(&atm);
     inside.render.camera_position_m = [0.0, (0.5 * (band.bottom_m + band.top_m)) as f32, 0.0];
     inside.render.camera_pitch_deg = 0.0;
-    parity(&ctx, &inside, &[(96, 64)], PARITY_MEAN, PARITY_MAX, PARITY_OUTLIERS);
+    parity(
+        &ctx,
+        &inside,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
 }
 
 /// With terrain, the GPU rasterises the heightfield as triangles where the

@@ -2,17 +2,19 @@
 //! needed): every WGSL function is the twin of a Rust function of the same
 //! name under `src/render/`, or on the short GPU-only list below with the
 //! reason; every WGSL constant equals its Rust twin; the `Frame` uniform's
-//! members sit at the offsets of `FrameUniforms`' fields, and `Sphere`'s at
-//! those of the baseline's `Sphere`.
+//! members sit at the offsets of `FrameUniforms`' fields, `Sphere`'s at
+//! those of the baseline's `Sphere`, and the sky tables' `SkyParams` and
+//! `SkyView` at those of `SkyParamsUniforms` and `SkyViewUniforms`. The
+//! sources are `all_variants()`, which includes `shaders/sky_luts.wgsl`.
 
 use std::collections::BTreeSet;
 use std::mem::offset_of;
 use std::path::Path;
 
-use cumulus::render::cpu::{density, lighting, renderer, sky};
+use cumulus::render::cpu::{density, lighting, renderer, sky, sky_luts};
 use cumulus::render::gpu::baseline::Sphere;
 use cumulus::render::gpu::shaders::all_variants;
-use cumulus::render::gpu::uniforms::FrameUniforms;
+use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
 
 /// WGSL functions with no Rust function of the same name, and why.
 const GPU_ONLY: &[(&str, &str)] = &[
@@ -28,6 +30,8 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("display", "the CPU's to_srgb8"),
     // glam's Vec3::normalize_or on the CPU.
     ("normalize_or", "glam's Vec3::normalize_or"),
+    // glam's Vec3::lerp (the sky tables' bilinear, Lut2::sample_texels).
+    ("lerp", "glam's Vec3::lerp"),
     // The composite's background: sky_radiance + sun_disk on the CPU.
     ("sky_background", "background_radiance per pixel"),
     ("sky_above", "the zenith sky, precomputed in FrameUniforms"),
@@ -78,6 +82,34 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("AMBIENT_GAIN", renderer::AMBIENT_GAIN as f64),
         ("GROUND_SHADOW_STEPS", renderer::GROUND_SHADOW_STEPS as f64),
         ("RAY_DEPTH", cumulus::render::camera::RAY_DEPTH as f64),
+        // shaders/sky_luts.wgsl (PI above is shared).
+        ("GOLDEN_ANGLE", sky_luts::GOLDEN_ANGLE as f64),
+        ("TRANSMITTANCE_WIDTH", sky_luts::TRANSMITTANCE_SIZE.0 as f64),
+        (
+            "TRANSMITTANCE_HEIGHT",
+            sky_luts::TRANSMITTANCE_SIZE.1 as f64,
+        ),
+        (
+            "MULTI_SCATTERING_WIDTH",
+            sky_luts::MULTI_SCATTERING_SIZE.0 as f64,
+        ),
+        (
+            "MULTI_SCATTERING_HEIGHT",
+            sky_luts::MULTI_SCATTERING_SIZE.1 as f64,
+        ),
+        ("SKY_VIEW_WIDTH", sky_luts::SKY_VIEW_SIZE.0 as f64),
+        ("SKY_VIEW_HEIGHT", sky_luts::SKY_VIEW_SIZE.1 as f64),
+        ("SKY_VIEW_HALF", sky_luts::SKY_VIEW_HALF as f64),
+        ("TRANSMITTANCE_STEPS", sky_luts::TRANSMITTANCE_STEPS as f64),
+        (
+            "MULTI_SCATTERING_DIRECTIONS",
+            sky_luts::MULTI_SCATTERING_DIRECTIONS as f64,
+        ),
+        (
+            "MULTI_SCATTERING_STEPS",
+            sky_luts::MULTI_SCATTERING_STEPS as f64,
+        ),
+        ("SKY_VIEW_STEPS", sky_luts::SKY_VIEW_STEPS as f64),
     ]
 }
 
@@ -207,4 +239,19 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
     same_layout("Frame", &rust, size_of::<FrameUniforms>());
     let rust = offsets!(Sphere: centre_radius, fill);
     same_layout("Sphere", &rust, size_of::<Sphere>());
+}
+
+#[test]
+fn sky_uniform_members_match_their_rust_blocks() {
+    macro_rules! offsets {
+        ($t:ty: $($f:ident),*) => { [$((stringify!($f), offset_of!($t, $f))),*] };
+    }
+    // SkyParamsUniforms' `_pad` is the WGSL struct's implicit tail padding.
+    let rust = offsets!(SkyParamsUniforms: rayleigh_scattering, ground_radius_km,
+        ozone_absorption, top_radius_km, ground_albedo, rayleigh_scale_height_km,
+        sun_irradiance, mie_scattering, mie_extinction, mie_scale_height_km, mie_g,
+        ozone_center_km, ozone_width_km, sun_angular_radius_deg);
+    same_layout("SkyParams", &rust, size_of::<SkyParamsUniforms>());
+    let rust = offsets!(SkyViewUniforms: camera_radius_km, sun_cos_zenith);
+    same_layout("SkyView", &rust, size_of::<SkyViewUniforms>());
 }

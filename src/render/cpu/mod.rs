@@ -11,3 +11,4 @@ pub mod density;
 pub mod lighting;
 pub mod renderer;
 pub mod sky;
+pub mod sky_luts;

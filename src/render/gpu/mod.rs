@@ -12,6 +12,7 @@ mod inputs;
 pub mod renderer;
 pub mod settings;
 pub mod shaders;
+pub mod sky_luts_pass;
 mod terrain_pass;
 pub mod textures;
 pub mod timer;

@@ -11,6 +11,9 @@ pub const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
 pub const TSAA: &str = include_str!("../../../shaders/tsaa.wgsl");
 /// The terrain pass.
 pub const TERRAIN: &str = include_str!("../../../shaders/terrain.wgsl");
+/// The sky tables' compute passes (standalone: not assembled with
+/// [`CLOUDS`]).
+pub const SKY_LUTS: &str = include_str!("../../../shaders/sky_luts.wgsl");
 
 /// The cloud pass's source: marches to the depth buffer's surface when
 /// `depth`, and writes the cloud distance for the TSAA reprojection when
@@ -91,11 +94,21 @@ pub fn baseline_pass() -> String {
     format!("{CLOUDS}\n{COMPOSITE}\n{}", super::baseline::BASELINE)
 }
 
+/// The sky tables' source: three compute entry points.
+pub fn sky_luts_pass() -> String {
+    SKY_LUTS.to_string()
+}
+
 /// Every variant's source: the cloud pass with and without depth and
-/// TSAA, the composite pass over each background, TSAA, terrain and the
-/// baseline.
+/// TSAA, the composite pass over each background, TSAA, terrain, the
+/// baseline and the sky tables.
 pub fn all_variants() -> Vec<String> {
-    let mut sources = vec![tsaa_pass(), terrain_pass(), baseline_pass()];
+    let mut sources = vec![
+        tsaa_pass(),
+        terrain_pass(),
+        baseline_pass(),
+        sky_luts_pass(),
+    ];
     for depth in [false, true] {
         for tsaa in [false, true] {
             sources.push(cloud_pass(depth, tsaa));

@@ -1,4 +1,4 @@
-//! The per-frame uniform block shared with WGSL.
+//! The uniform blocks shared with WGSL: the frame's, and the sky tables'.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -7,6 +7,9 @@ use crate::render::camera::View;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::{Quality, SUN_INTENSITY};
 use crate::render::cpu::sky::{sky_radiance, sun_color, sun_direction};
+use crate::render::cpu::sky_luts::SkyParams;
+#[cfg(doc)]
+use crate::render::cpu::sky_luts::radius_at_altitude;
 
 // Keep in sync with shaders/clouds.wgsl: Frame.
 /// Everything the passes read per frame; one `vec4` per line of the WGSL
@@ -111,3 +114,64 @@ impl FrameUniforms {
         }
     }
 }
+
+// Keep in sync with shaders/sky_luts.wgsl: SkyParams.
+/// [`SkyParams`] as the sky tables' WGSL reads it: each `vec3f` shares its
+/// 16 bytes with the scalar after it; 88 bytes of members, 96 in all.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct SkyParamsUniforms {
+    pub rayleigh_scattering: [f32; 3],
+    pub ground_radius_km: f32,
+    pub ozone_absorption: [f32; 3],
+    pub top_radius_km: f32,
+    pub ground_albedo: [f32; 3],
+    pub rayleigh_scale_height_km: f32,
+    pub sun_irradiance: [f32; 3],
+    pub mie_scattering: f32,
+    pub mie_extinction: f32,
+    pub mie_scale_height_km: f32,
+    pub mie_g: f32,
+    pub ozone_center_km: f32,
+    pub ozone_width_km: f32,
+    pub sun_angular_radius_deg: f32,
+    /// The WGSL struct's tail padding (its size rounds up to 16 bytes).
+    pub _pad: [f32; 2],
+}
+
+const _: () = assert!(size_of::<SkyParamsUniforms>() == 96);
+
+impl SkyParamsUniforms {
+    /// The block of `p`, field for field.
+    pub fn new(p: &SkyParams) -> Self {
+        Self {
+            rayleigh_scattering: p.rayleigh_scattering.to_array(),
+            ground_radius_km: p.ground_radius_km,
+            ozone_absorption: p.ozone_absorption.to_array(),
+            top_radius_km: p.top_radius_km,
+            ground_albedo: p.ground_albedo.to_array(),
+            rayleigh_scale_height_km: p.rayleigh_scale_height_km,
+            sun_irradiance: p.sun_irradiance.to_array(),
+            mie_scattering: p.mie_scattering,
+            mie_extinction: p.mie_extinction,
+            mie_scale_height_km: p.mie_scale_height_km,
+            mie_g: p.mie_g,
+            ozone_center_km: p.ozone_center_km,
+            ozone_width_km: p.ozone_width_km,
+            sun_angular_radius_deg: p.sun_angular_radius_deg,
+            _pad: [0.0; 2],
+        }
+    }
+}
+
+// Keep in sync with shaders/sky_luts.wgsl: SkyView.
+/// The sky view's inputs besides [`SkyParams`]: the camera's radius (km,
+/// [`radius_at_altitude`]) and the sun's cos zenith.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct SkyViewUniforms {
+    pub camera_radius_km: f32,
+    pub sun_cos_zenith: f32,
+}
+
+const _: () = assert!(size_of::<SkyViewUniforms>() == 8);
