@@ -444,8 +444,6 @@ fn flat_ground_shadow(origin: vec3f, dir: vec3f, sun_dir: vec3f) -> f32 {
     return cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);
 }
 
-
-
 // Schlick's Fresnel reflectance of water (the CPU's `fresnel_water`).
 fn fresnel_water(cos_i: f32) -> f32 {
     let c = 1.0 - clamp(cos_i, 0.0, 1.0);
