@@ -120,6 +120,9 @@ fn march_spheres(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
     let steps = max(frame.counts.x, 1u);
     let dt = (seg.y - seg.x) / f32(steps);
     let cos_theta = dot(dir, sun_dir);
+    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
+    let sky_top = sky_ambient(sun_dir) * 0.25;
+    let ground = ground_up(sun_dir, SEA) * 0.25;
     var transmittance = 1.0;
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
@@ -132,8 +135,8 @@ fn march_spheres(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
         }
         let tau_sun = sphere_optical_depth(p, sun_dir);
         let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let ambient = frame.ambient_top.xyz * (AMBIENT_GAIN * (0.35 + 0.65 * eta));
-        let s = (frame.sun_light.xyz * sun_scattering(tau_sun, cos_theta, frame.sun_dir.y) + ambient) * (sigma_t * ALBEDO);
+        let ambient = ambient_light(sky_top, ground, eta);
+        let s = (sun * sun_scattering(tau_sun, cos_theta, frame.sun_dir.y) + ambient) * (sigma_t * ALBEDO);
         let step_t = exp(-sigma_t * dt);
         light += integrate_step(s, sigma_t, dt) * transmittance;
         depth_weighted += t * transmittance * (1.0 - step_t);
@@ -147,9 +150,8 @@ fn march_spheres(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
     if opacity > 0.0 {
         distance = depth_weighted / opacity;
     }
-    let haze = exp(-distance / max(frame.sun_dir.w, 1.0));
-    let horizon = sky_radiance(normalize_or(vec3f(dir.x, max(dir.y, 0.0), dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
-    return vec4f(light * haze + horizon * (opacity * (1.0 - haze)), opacity);
+    let a = aerial(dir, distance, sun_dir);
+    return vec4f(light * a.transmittance + a.inscatter * opacity, opacity);
 }
 
 @fragment

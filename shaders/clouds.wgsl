@@ -18,6 +18,9 @@ override DEBUG_COUNT: bool = false;
 // The sea below the horizon (else land), and its wind speed (m/s).
 override SEA: bool = false;
 override SEA_WIND_MPS: f32 = 7.0;
+// Fade clouds and ground with distance (`[render.atmosphere]
+// aerial_perspective`), read by the sky file's `aerial`.
+override AERIAL_PERSPECTIVE: bool = true;
 
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
@@ -63,8 +66,8 @@ struct Frame {
     screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
-    ambient_top: vec4f,  // sky_radiance(up) / 4, exposure
-    sky_up: vec4f,       // sky_radiance(up), unused (w)
+    ambient_top: vec4f,  // unused (xyz: the analytic sky_above(up) / 4), exposure
+    sky_up: vec4f,       // unused (xyz: the analytic sky_above(up), w: 0)
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
@@ -365,16 +368,17 @@ fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32) -> f32 {
     return sum;
 }
 
+// The sky's and the ground's light scattered at height fraction `eta`
+// (the CPU's `ambient_light`).
+fn ambient_light(sky_top: vec3f, ground: vec3f, eta: f32) -> vec3f {
+    return (sky_top * (0.35 + 0.65 * eta) + ground * (1.0 - 0.65 * eta)) * AMBIENT_GAIN;
+}
+
 fn integrate_step(s: vec3f, sigma_t: f32, dt: f32) -> vec3f {
     if sigma_t * dt < 1e-5 {
         return s * dt;
     }
     return (s - s * exp(-sigma_t * dt)) / sigma_t;
-}
-
-fn sun_color(sun_dir: vec3f) -> vec3f {
-    let air_mass = 1.0 / max(sun_dir.y, 0.035);
-    return exp(-vec3f(0.018, 0.04, 0.09) * air_mass);
 }
 
 fn normalize_or(v: vec3f, fallback: vec3f) -> vec3f {
@@ -385,35 +389,29 @@ fn normalize_or(v: vec3f, fallback: vec3f) -> vec3f {
     return fallback;
 }
 
-// The sky above the horizon (dir.y >= 0).
-fn sky_above(dir: vec3f, sun_dir: vec3f) -> vec3f {
-    let sun = sun_color(sun_dir);
-    let day = max(sqrt(clamp(sun_dir.y, 0.0, 1.0)), 0.15);
-    let zenith = vec3f(0.16, 0.32, 0.75);
-    let horizon = vec3f(0.62, 0.72, 0.86);
-    let f = pow(1.0 - dir.y, 4.0);
-    let base = mix(zenith, horizon, f) * day * mix(sun, vec3f(1.0), 0.6);
-    let glow = sun * (phase_hg(dot(dir, sun_dir), 0.76) * 0.35);
-    return base + glow;
+// (inscattered light, transmittance) of the air in front of something
+// (the CPU's `aerial`, a tuple there).
+struct Aerial {
+    inscatter: vec3f,
+    transmittance: vec3f,
 }
 
-// The flat land through the haze, its sunlit part dimmed by the clouds'
+// The sky file appended after this one (sky_analytic.wgsl or
+// sky_physical.wgsl) defines sun_light_at, sky_above, aerial, ground_haze
+// and sun_disk, the twins of src/render/cpu/sky.rs.
+
+// The flat land's own light (the CPU's `land_surface`; the albedo is its
+// LAND_ALBEDO).
+fn land_surface(sun_dir: vec3f, shadow: f32) -> vec3f {
+    let sun = sun_light_at(0.0, sun_dir);
+    let lit = sun * (max(sun_dir.y, 0.0) * shadow / PI) + sky_ambient(sun_dir);
+    return vec3f(0.08, 0.1, 0.06) * lit;
+}
+
+// The flat land through the air, its sunlit part dimmed by the clouds'
 // shadow (the CPU's `land_radiance`).
 fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
-    // frame.sun_light is sun_color(sun_dir) * SUN_INTENSITY, and sky_up
-    // the zenith's sky_radiance; the albedo is the CPU's LAND_ALBEDO.
-    let lit = frame.sun_light.xyz * (max(sun_dir.y, 0.0) * shadow / PI) + frame.sky_up.xyz;
-    let ground = vec3f(0.08, 0.1, 0.06) * lit;
-    let horizon = sky_above(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
-    let f = exp(-(-dir.y) * 40.0);
-    return mix(ground, horizon, f);
-}
-
-fn sky_radiance(dir: vec3f, sun_dir: vec3f) -> vec3f {
-    if dir.y < 0.0 {
-        return land_radiance(dir, sun_dir, 1.0);
-    }
-    return sky_above(dir, sun_dir);
+    return ground_haze(land_surface(sun_dir, shadow), dir, sun_dir);
 }
 
 fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
@@ -450,14 +448,20 @@ fn fresnel_water(cos_i: f32) -> f32 {
     return WATER_F0 + (1.0 - WATER_F0) * c * c * c * c * c;
 }
 
+// The water's own light (the CPU's `water_light`).
+fn water_light(sun: vec3f, sun_dir: vec3f) -> vec3f {
+    return vec3f(0.004, 0.012, 0.02)
+        * (sun * (max(sun_dir.y, 0.0) / PI) + sky_ambient(sun_dir));
+}
+
 // The wind-roughened sea along `dir` (pointing down): the reflected sky,
 // the sun's glint (Cox-Munk slopes, Beckmann), the water's own blue, the
-// horizon's haze (the CPU's `sea_radiance`).
+// air in front (the CPU's `sea_radiance`).
 fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
     let mu = max(-dir.y, 1e-3);
     let f = fresnel_water(mu);
-    let reflected = sky_radiance(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
-    let sun = frame.sun_light.xyz * shadow;
+    let reflected = sky_above(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+    let sun = sun_light_at(0.0, sun_dir) * shadow;
     let variance = 0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0);
     let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
     let cos_b = max(h.y, 1e-3);
@@ -467,30 +471,30 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
     if sun_dir.y > 0.0 {
         glint = sun * (fresnel_water(dot(h, sun_dir)) * d / (4.0 * mu));
     }
-    let water = vec3f(0.004, 0.012, 0.02)
-        * (sun * (max(sun_dir.y, 0.0) / PI) + sky_radiance(vec3f(0.0, 1.0, 0.0), sun_dir));
-    let surface = reflected * f + glint + water * (1.0 - f);
-    let horizon = sky_radiance(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
-    return mix(surface, horizon, exp(-mu * 40.0));
+    let surface = reflected * f + glint + water_light(sun, sun_dir) * (1.0 - f);
+    return ground_haze(surface, dir, sun_dir);
+}
+
+// The light rising from the flat ground, unshadowed (the CPU's
+// `ground_up`).
+fn ground_up(sun_dir: vec3f, sea: bool) -> vec3f {
+    if sea {
+        let sun = sun_light_at(0.0, sun_dir);
+        return sky_above(vec3f(0.0, 1.0, 0.0), sun_dir) * WATER_F0 + water_light(sun, sun_dir) * (1.0 - WATER_F0);
+    }
+    return land_surface(sun_dir, 1.0);
 }
 
 // The sky and the sun disk, or below the horizon the land or the sea in
 // the clouds' shadow (the CPU's `background_radiance`).
 fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
     if dir.y >= 0.0 {
-        return sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir);
+        return sky_above(dir, sun_dir) + sun_disk(dir, sun_dir);
     }
     if SEA {
         return sea_radiance(dir, sun_dir, shadow);
     }
     return land_radiance(dir, sun_dir, shadow);
-}
-
-fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {
-    if dot(dir, sun_dir) > SUN_DISK_COS {
-        return sun_color(sun_dir) * 60.0;
-    }
-    return vec3f(0.0);
 }
 
 // The blue-noise tile's offset of pixel (x, y) (the CPU's `pixel_dither`).
@@ -575,8 +579,9 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let steps = max(frame.counts.x, 1u);
     let log_ratio = log((t1 + NEAR_M) / (t0 + NEAR_M));
     let spread = frame.cam_pos.w;
-    let sun = frame.sun_light.xyz;
-    let ambient_top = frame.ambient_top.xyz;
+    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
+    let sky_top = sky_ambient(sun_dir) * 0.25;
+    let ground = ground_up(sun_dir, SEA) * 0.25;
     let cos_theta = dot(dir, sun_dir);
     let parts = shadow_parts(SHADOW_STEPS);
     var transmittance = 1.0;
@@ -629,7 +634,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
             if lit {
                 lit = false;
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-                let ambient = ambient_top * (AMBIENT_GAIN * (0.35 + 0.65 * eta));
+                let ambient = ambient_light(sky_top, ground, eta);
                 let scatter = sun * sun_scattering(tau, cos_theta, sun_dir.y) + ambient;
                 let s = scatter * (lit_sigma * ALBEDO);
                 let step_t = exp(-lit_sigma * h);
@@ -694,9 +699,8 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
         cloud_distance = depth_weighted / opacity;
         out.distance = cloud_distance;
     }
-    let haze = exp(-cloud_distance / max(frame.sun_dir.w, 1.0));
-    let horizon = sky_radiance(normalize_or(vec3f(dir.x, max(dir.y, 0.0), dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
-    out.premultiplied = vec4f(light * haze + horizon * (opacity * (1.0 - haze)), opacity);
+    let a = aerial(dir, cloud_distance, sun_dir);
+    out.premultiplied = vec4f(light * a.transmittance + a.inscatter * opacity, opacity);
     out.samples = samples;
     return out;
 }

@@ -2,11 +2,12 @@
 // the Rust function of the same name in src/render/cpu/sky_luts/ (same
 // arguments in the same order; a Rust tuple is a vec2f or a small struct
 // here, a `&Lut2` a `texture_2d<f32>` read with textureLoad). Lengths in
-// km, coefficients 1/km, as on the CPU. Three compute entry points write
-// the transmittance, multiple-scattering and sky-view tables (rgba32float,
-// alpha 1). Standalone: not assembled with clouds.wgsl.
+// km, coefficients 1/km, as on the CPU. A library without bindings or
+// `PI`: sky_luts_build.wgsl appends the three compute entry points that
+// write the tables (rgba32float, alpha 1), and the physical sky
+// (sky_physical.wgsl, after clouds.wgsl) reads them with the lookups at
+// the end.
 
-const PI: f32 = 3.14159265358979;
 const GOLDEN_ANGLE: f32 = 2.399963;
 const TRANSMITTANCE_WIDTH: u32 = 256u;
 const TRANSMITTANCE_HEIGHT: u32 = 64u;
@@ -19,6 +20,8 @@ const TRANSMITTANCE_STEPS: u32 = 40u;
 const MULTI_SCATTERING_DIRECTIONS: u32 = 64u;
 const MULTI_SCATTERING_STEPS: u32 = 20u;
 const SKY_VIEW_STEPS: u32 = 30u;
+const AERIAL_PERSPECTIVE_STEPS: u32 = 10u;
+const LIMB_DARKENING_U: f32 = 0.6;
 
 // Keep in sync with src/render/gpu/uniforms.rs: SkyParamsUniforms (96
 // bytes; each vec3f shares its 16 bytes with the f32 after it).
@@ -429,44 +432,71 @@ fn sky_view_texel(
     return s.inscatter * p.sun_irradiance;
 }
 
-// ---- Entry points: one invocation per texel ----
+// ---- Lookups (src/render/cpu/sky_luts/lookups.rs) ----
 
-@group(0) @binding(0) var<uniform> params: SkyParams;
-@group(0) @binding(1) var lut_out: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(2) var transmittance_lut: texture_2d<f32>;
-@group(0) @binding(3) var multi_scattering_lut: texture_2d<f32>;
-@group(0) @binding(4) var<uniform> sky_view_inputs: SkyView;
-
-@compute @workgroup_size(8, 8)
-fn cs_transmittance(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= TRANSMITTANCE_WIDTH || id.y >= TRANSMITTANCE_HEIGHT {
-        return;
-    }
-    textureStore(lut_out, id.xy, vec4f(transmittance_texel(id.x, id.y, params), 1.0));
+fn radius_at_altitude(altitude_m: f32, p: SkyParams) -> f32 {
+    return clamp(p.ground_radius_km + altitude_m * 1e-3, p.ground_radius_km, p.top_radius_km);
 }
 
-@compute @workgroup_size(8, 8)
-fn cs_multi_scattering(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= MULTI_SCATTERING_WIDTH || id.y >= MULTI_SCATTERING_HEIGHT {
-        return;
-    }
-    let c = multi_scattering_texel(id.x, id.y, params, transmittance_lut);
-    textureStore(lut_out, id.xy, vec4f(c, 1.0));
+fn azimuth_from_sun(dir: vec3f, sun_dir: vec3f) -> f32 {
+    let cross = dir.z * sun_dir.x - dir.x * sun_dir.z;
+    let dot = dir.x * sun_dir.x + dir.z * sun_dir.z;
+    return atan2(abs(cross), dot);
 }
 
-@compute @workgroup_size(8, 8)
-fn cs_sky_view(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= SKY_VIEW_WIDTH || id.y >= SKY_VIEW_HEIGHT {
-        return;
-    }
-    let c = sky_view_texel(
-        id.x,
-        id.y,
-        sky_view_inputs.camera_radius_km,
-        sky_view_inputs.sun_cos_zenith,
-        params,
-        transmittance_lut,
-        multi_scattering_lut,
+fn sky_ray(altitude_m: f32, dir: vec3f, sun_dir: vec3f, p: SkyParams) -> SkyRay {
+    return SkyRay(radius_at_altitude(altitude_m, p), dir.y, sun_dir.y, dot(dir, sun_dir));
+}
+
+fn sky_view_radiance(
+    sky_view: texture_2d<f32>,
+    camera_altitude_m: f32,
+    p: SkyParams,
+    dir: vec3f,
+    sun_dir: vec3f,
+) -> vec3f {
+    let r = radius_at_altitude(camera_altitude_m, p);
+    let c = sky_view_texel_coords(dir.y, azimuth_from_sun(dir, sun_dir), r, p);
+    return sample_texels(sky_view, c.fx, c.fy, c.row_min, c.row_max);
+}
+
+fn aerial_perspective(
+    transmittance: texture_2d<f32>,
+    multi_scattering: texture_2d<f32>,
+    p: SkyParams,
+    altitude_m: f32,
+    dir: vec3f,
+    distance_m: f32,
+    sun_dir: vec3f,
+) -> Scattering {
+    let ray = sky_ray(altitude_m, dir, sun_dir, p);
+    let t_max = clamp(distance_m * 1e-3, 0.0, distance_to_boundary(ray.r, ray.mu, p));
+    let s = integrate_scattering(
+        ray,
+        t_max,
+        AERIAL_PERSPECTIVE_STEPS,
+        p,
+        transmittance,
+        multi_scattering,
     );
-    textureStore(lut_out, id.xy, vec4f(c, 1.0));
+    return Scattering(s.inscatter * p.sun_irradiance, s.transmittance);
+}
+
+fn sun_radiance_at(transmittance: texture_2d<f32>, p: SkyParams, altitude_m: f32, sun_dir: vec3f) -> vec3f {
+    let r = radius_at_altitude(altitude_m, p);
+    return transmittance_to_sun(transmittance, r, sun_dir.y, p) * p.sun_irradiance;
+}
+
+fn sun_disk_radiance(dir: vec3f, sun_dir: vec3f, irradiance: vec3f, angular_radius_rad: f32) -> vec3f {
+    let d = dir - sun_dir;
+    let one_minus_cos = 0.5 * dot(d, d);
+    let half = sin(0.5 * angular_radius_rad);
+    let cap = 2.0 * half * half;
+    if one_minus_cos >= cap {
+        return vec3f(0.0);
+    }
+    let mu = sqrt(1.0 - one_minus_cos / cap);
+    let solid_angle = 2.0 * PI * cap;
+    return irradiance * (1.0 - LIMB_DARKENING_U * (1.0 - mu))
+        / (solid_angle * (1.0 - LIMB_DARKENING_U / 3.0));
 }

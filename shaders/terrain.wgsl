@@ -45,12 +45,11 @@ fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
     if SHADOW_STEPS > 0u && sun_dir.y > 0.0 {
         shadow = cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);
     }
-    let sun = frame.sun_light.xyz;
-    let sky = frame.sky_up.xyz;
+    let sun = sun_light_at(p.y, sun_dir);
+    let sky = sky_ambient(sun_dir);
     let lit = albedo * (sun * (max(dot(n, sun_dir), 0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
-    let haze = exp(-t / max(frame.sun_dir.w, 1.0));
-    let horizon = sky_radiance(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);
-    return lit * haze + horizon * (1.0 - haze);
+    let a = aerial(dir, t, sun_dir);
+    return lit * a.transmittance + a.inscatter;
 }
 
 struct TerrainVertex {

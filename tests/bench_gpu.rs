@@ -10,6 +10,7 @@ use common::gpu;
 
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::Camera;
+use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::gpu::baseline::BaselineRenderer;
 use cumulus::render::gpu::headless::TARGET_FORMAT;
 use cumulus::render::gpu::{Headless, textures};
@@ -155,6 +156,9 @@ fn baseline_and_cloud_map_draw_the_same_parcels() {
     // baseline does not), and the mask against the clear ground would
     // count those shadows as cloud.
     sc.render.shadow_steps = 0;
+    // The baseline draws under the analytic sky: its clear sky is the mask's
+    // reference.
+    sc.render.atmosphere.model = SkyModel::Analytic;
     let p = Prepared::from_scene(&sc, || {}).unwrap();
     let l = sc.physics.domain_size_m as f32;
     // Straight down on the whole domain from above the layer.

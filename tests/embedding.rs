@@ -256,7 +256,7 @@ fn every_depth_convention_hides_the_same_clouds() {
     assert!(hi - lo < 0.02, "shares hidden by the wall: {all_shares:?}");
 }
 
-/// The clouds-only layer composited over the analytic sky on the CPU
+/// The clouds-only layer composited over the scene's sky on the CPU
 /// (`rgb + (1 - a) · sky`, the ground in the clouds' shadows below the
 /// horizon, tone-mapped) is the renderer's own composite:
 /// the output is linear, premultiplied, and leaves the background out.
@@ -303,7 +303,7 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
             let (x, y) = ((k as u32 % W) as f32 + 0.5, (k as u32 / W) as f32 + 0.5);
             let dir = view.camera_ray(x, y, W, H);
             let shadow = flat_ground_shadow(view.eye(), dir, sun, &frame);
-            let sky = background_radiance(dir, sun, q.sea_wind_mps, shadow);
+            let sky = background_radiance(&frame.sky_light(), dir, sun, q.sea_wind_mps, shadow);
             Vec3::new(px[0], px[1], px[2]) + (1.0 - px[3]) * sky
         })
         .collect();

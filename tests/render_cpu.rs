@@ -7,6 +7,7 @@ use cumulus::render::cpu::density::{
 };
 use cumulus::render::cpu::lighting::sun_transmittance;
 use cumulus::render::cpu::renderer::{Frame, Quality, march_ray, render_linear, to_srgb8};
+use cumulus::render::cpu::sky::{AtmosphereConfig, SkyModel};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
 
@@ -246,8 +247,13 @@ fn constant_slab_transmittance_matches_beer_lambert() {
             max_distance_m: 1e5,
             exposure: 1.0,
             sea_wind_mps: None,
+            atmosphere: AtmosphereConfig {
+                model: SkyModel::Analytic,
+                ..AtmosphereConfig::default()
+            },
         },
         terrain: None,
+        sky: None,
     };
     let s = march_ray(origin, Vec3::Y, 0.5, 0.0, &frame);
     let expected = (-tau).exp() as f32;
@@ -279,8 +285,13 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
             max_distance_m: 40_000.0,
             exposure: 1.2,
             sea_wind_mps: None,
+            atmosphere: AtmosphereConfig {
+                model: SkyModel::Analytic,
+                ..AtmosphereConfig::default()
+            },
         },
         terrain: None,
+        sky: None,
     }
 }
 

@@ -8,8 +8,9 @@ mod common;
 use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::cpu::renderer::{render_converged, render_linear, to_srgb8};
+use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::gpu::renderer::{PASS_CLOUDS, PASS_COMPOSITE, PASS_TERRAIN, PASS_TSAA};
-use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuError, RenderError};
+use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuError, Headless, RenderError};
 use cumulus::scene::{RenderSettings, Scene};
 
 fn scene(name: &str) -> Scene {
@@ -261,6 +262,77 @@ fn each_scene_builds_only_the_passes_it_needs() {
     hl.renderer.set_settings(&s);
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     assert!(hl.renderer.textures().contains(&"clouds.detail_volume"));
+
+    // The physical sky's tables exist only under the physical sky; a
+    // still frame builds none, a new sun elevation rebuilds the sky view
+    // alone, and switching the model live rebinds every pass.
+    let tables = |hl: &Headless| {
+        let t = hl.renderer.textures();
+        t.iter().filter(|n| n.starts_with("sky_luts.")).count()
+    };
+    assert_eq!(tables(&hl), 3);
+    let before = hl.renderer.sky_table_builds().expect("physical");
+    hl.render(&ctx, &r.camera(), 2).expect("frames");
+    assert_eq!(hl.renderer.sky_table_builds(), Some(before));
+    s.sun_elevation_deg += 3.0;
+    hl.renderer.set_settings(&s);
+    hl.render(&ctx, &r.camera(), 1).expect("frame");
+    let after = hl.renderer.sky_table_builds().expect("physical");
+    assert_eq!(
+        (after.transmittance, after.sky_view),
+        (before.transmittance, before.sky_view + 1)
+    );
+    s.quality.atmosphere.model = SkyModel::Analytic;
+    hl.renderer.set_settings(&s);
+    hl.render(&ctx, &r.camera(), 1).expect("frame");
+    assert_eq!(tables(&hl), 0);
+    assert_eq!(hl.renderer.sky_table_builds(), None);
+    s.quality.atmosphere.model = SkyModel::Physical;
+    hl.renderer.set_settings(&s);
+    hl.render(&ctx, &r.camera(), 1).expect("frame");
+    assert_eq!(tables(&hl), 3);
+}
+
+/// A low sun lights clouds warm: under the physical sky the sunlit cloud
+/// of `evening` (the brightest quarter of its opaque pixels, in the GPU's
+/// cloud layer) has red above blue by a tenth or more, where under the
+/// analytic sky's fixed air mass it stays nearer grey.
+#[test]
+fn a_low_sun_lights_clouds_warm() {
+    let Some(ctx) = gpu() else { return };
+    let mut sc = scene("evening");
+    sc.render.tsaa = false;
+    sc.render.terrain.enabled = false;
+    let (w, h) = (96, 72);
+    sc.render.width = w;
+    sc.render.height = h;
+    let p = Prepared::from_scene(&sc, || {}).expect("prepare");
+    let warmth = |model: SkyModel| {
+        let mut r = sc.render.clone();
+        r.atmosphere.model = model;
+        let mut hl = p
+            .headless(&ctx, &p.gpu_settings(&r, r.quality()), w, h)
+            .expect("renderer");
+        hl.render(&ctx, &r.camera(), 1).expect("frame");
+        let mut lit: Vec<[f32; 4]> = cloud_layer(&ctx, &hl.renderer)
+            .into_iter()
+            .filter(|c| c[3] > 0.95)
+            .collect();
+        assert!(lit.len() > 100, "{} opaque pixels", lit.len());
+        lit.sort_by(|a, b| (b[0] + b[1] + b[2]).total_cmp(&(a[0] + a[1] + a[2])));
+        let top = &lit[..lit.len() / 4];
+        let red: f32 = top.iter().map(|c| c[0]).sum();
+        let blue: f32 = top.iter().map(|c| c[2]).sum();
+        red / blue
+    };
+    let physical = warmth(SkyModel::Physical);
+    let analytic = warmth(SkyModel::Analytic);
+    eprintln!(
+        "sunlit cloud red/blue at {}°: physical {physical:.2}, analytic {analytic:.2}",
+        sc.render.sun_elevation_deg
+    );
+    assert!(physical > 1.1, "physical red/blue {physical}");
+    assert!(physical > analytic, "{physical} {analytic}");
 }
 
 /// Reads the cloud layer (premultiplied radiance, opacity) of the last frame.

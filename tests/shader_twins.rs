@@ -34,7 +34,6 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("lerp", "glam's Vec3::lerp"),
     // The composite's background: sky_radiance + sun_disk on the CPU.
     ("sky_background", "background_radiance per pixel"),
-    ("sky_above", "the zenith sky, precomputed in FrameUniforms"),
     // Integer wrap of texel indices (rem_euclid on the CPU).
     ("wrap_i", "i64::rem_euclid on the CPU"),
     // The per-parcel baseline exists only on the GPU, for `cumulus bench`.
@@ -110,6 +109,11 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             sky_luts::MULTI_SCATTERING_STEPS as f64,
         ),
         ("SKY_VIEW_STEPS", sky_luts::SKY_VIEW_STEPS as f64),
+        (
+            "AERIAL_PERSPECTIVE_STEPS",
+            sky_luts::AERIAL_PERSPECTIVE_STEPS as f64,
+        ),
+        ("LIMB_DARKENING_U", sky_luts::LIMB_DARKENING_U as f64),
     ]
 }
 

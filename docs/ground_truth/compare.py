@@ -69,8 +69,6 @@ def scene_variant(base, sun_el, sun_az, yaw, width, height, path):
         "sun_azimuth_deg": str(sun_az),
         "width": str(width),
         "height": str(height),
-        # The path tracer's scene has no air: no haze on ours either.
-        "haze_distance_m": "1e7",
     }
     out, in_render = [], False
     for line in text.splitlines():
@@ -83,6 +81,9 @@ def scene_variant(base, sun_el, sun_az, yaw, width, height, path):
         out.append(line)
         if stripped == "[render]":
             out.extend(f"{k} = {v}" for k, v in keys.items())
+    # The path tracer's scene has no air: no aerial perspective on ours
+    # either (the sky and the sun's colour stay the scene's).
+    out.append("\n[render.atmosphere]\naerial_perspective = false")
     # Paths inside the scene (soundings) are relative to scenes/.
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")

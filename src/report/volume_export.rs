@@ -21,8 +21,8 @@ use serde::Serialize;
 
 use crate::io::write_atomically;
 use crate::render::cpu::density::density_at;
-use crate::render::cpu::renderer::{ALBEDO, Frame, SUN_INTENSITY};
-use crate::render::cpu::sky::{sea_radiance, sky_radiance, sun_color, sun_direction};
+use crate::render::cpu::renderer::{ALBEDO, Frame};
+use crate::render::cpu::sky::{sea_radiance, sky_radiance, sun_direction, sun_light_at};
 
 /// The largest number of cells along one axis.
 pub const MAX_CELLS: u32 = 2048;
@@ -282,13 +282,14 @@ pub fn envmap_direction(i: u32, j: u32, width: u32, height: u32) -> Vec3 {
 /// Mitsuba 3's `envmap` ([`envmap_direction`]).
 pub fn sky_envmap(frame: &Frame, width: u32, height: u32) -> Vec<f32> {
     let sun = sun_direction(frame.sun_elevation_deg, frame.sun_azimuth_deg);
+    let sky = &frame.sky_light();
     (0..height)
         .flat_map(|j| (0..width).map(move |i| (i, j)))
         .flat_map(|(i, j)| {
             let d = envmap_direction(i, j, width, height);
             match frame.quality.sea_wind_mps {
-                Some(wind) if d.y < 0.0 => sea_radiance(d, sun, wind, 1.0),
-                _ => sky_radiance(d, sun),
+                Some(wind) if d.y < 0.0 => sea_radiance(sky, d, sun, wind, 1.0),
+                _ => sky_radiance(sky, d, sun),
             }
             .to_array()
         })
@@ -330,7 +331,8 @@ pub struct Sidecar {
     pub sun_azimuth_deg: f32,
     /// The sun's irradiance on a surface facing it, linear RGB in the
     /// renderer's units (its in-scattered radiance is this times the
-    /// phase function).
+    /// phase function), at the cloud band's middle (the physical sky's
+    /// sun reddens with its path through the air).
     pub sun_irradiance_rgb: [f32; 3],
     /// The scene's camera: eye, the point it looks at, up, vertical field
     /// of view and image size.
@@ -390,7 +392,12 @@ impl Sidecar {
             sun_direction: sun.to_array(),
             sun_elevation_deg: frame.sun_elevation_deg,
             sun_azimuth_deg: frame.sun_azimuth_deg,
-            sun_irradiance_rgb: (sun_color(sun) * SUN_INTENSITY).to_array(),
+            sun_irradiance_rgb: sun_light_at(
+                &frame.sky_light(),
+                0.5 * (frame.density.band_bottom_m + frame.density.band_top_m),
+                sun,
+            )
+            .to_array(),
             camera_origin_m: eye.to_array(),
             camera_target_m: (eye + forward * 1000.0).to_array(),
             camera_up: [0.0, 1.0, 0.0],

@@ -8,7 +8,7 @@ use crate::render::camera::Camera;
 use crate::render::cloud_map::CloudMapConfig;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::Quality;
-use crate::render::cpu::sky::GroundConfig;
+use crate::render::cpu::sky::{AtmosphereConfig, GroundConfig};
 use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::TerrainConfig;
 use crate::sim::{Band, Check};
@@ -55,7 +55,9 @@ pub struct RenderSettings {
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
     /// (the octaves were fitted to the path tracer with 3).
     pub octaves: u32,
-    /// Aerial-perspective distance, m (> 0). Default 25000.
+    /// The analytic sky's aerial-perspective distance, m (> 0). Default
+    /// 25000 (the physical sky's haze comes from its air,
+    /// `[render.atmosphere]`).
     pub haze_distance_m: f32,
     /// Longest ray, m (> 0). Default 40000.
     pub max_distance_m: f32,
@@ -79,6 +81,9 @@ pub struct RenderSettings {
     /// The ground where there is no terrain (`[render.ground]`): land by
     /// default, or the sea.
     pub ground: GroundConfig,
+    /// The sky model and aerial perspective (`[render.atmosphere]`):
+    /// physical by default.
+    pub atmosphere: AtmosphereConfig,
 }
 
 impl Default for RenderSettings {
@@ -109,6 +114,7 @@ impl Default for RenderSettings {
             cloud_map: Default::default(),
             terrain: TerrainConfig::default(),
             ground: GroundConfig::default(),
+            atmosphere: AtmosphereConfig::default(),
         }
     }
 }
@@ -271,6 +277,13 @@ impl RenderSettings {
             ),
             range("render.terrain.hills", r.terrain.hills, 1.0, 64.0, "1..=64"),
             range(
+                "render.atmosphere.aerosol_optical_depth",
+                f(r.atmosphere.aerosol_optical_depth),
+                0.0,
+                3.0,
+                "0..=3",
+            ),
+            range(
                 "render.ground.wind_speed_mps",
                 f(r.ground.wind_speed_mps),
                 0.0,
@@ -347,6 +360,7 @@ impl RenderSettings {
             max_distance_m: self.max_distance_m,
             exposure: self.exposure,
             sea_wind_mps: self.ground.sea_wind_mps(),
+            atmosphere: self.atmosphere,
         }
     }
 }

@@ -8,7 +8,11 @@ use rayon::prelude::*;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
-use super::sky::{background_radiance, sky_radiance, sun_color, sun_direction};
+use super::sky::{
+    AtmosphereConfig, SkyLight, aerial, background_radiance, ground_up, sky_ambient, sun_direction,
+    sun_light_at,
+};
+use super::sky_luts::SkyLuts;
 use crate::render::camera::View;
 use crate::render::sampling::{self, frame_offset, jitter};
 use crate::render::terrain::Heightfield;
@@ -23,7 +27,8 @@ pub struct Quality {
     pub shadow_steps: u32,
     /// Extra multiple-scattering octaves, 0..=3.
     pub octaves: u32,
-    /// Distance at which aerial perspective has faded a cloud to 1/e, m.
+    /// Distance at which the analytic model's aerial perspective has
+    /// faded a cloud to 1/e, m.
     pub haze_distance_m: f32,
     /// Rays stop after this distance, m.
     pub max_distance_m: f32,
@@ -32,6 +37,8 @@ pub struct Quality {
     /// The sea below the horizon with this wind speed, m/s (`None`:
     /// land; [`super::sky::background_radiance`]).
     pub sea_wind_mps: Option<f32>,
+    /// The sky model and aerial perspective (`[render.atmosphere]`).
+    pub atmosphere: AtmosphereConfig,
 }
 
 /// Single-scattering albedo of cloud droplets.
@@ -52,6 +59,22 @@ pub struct Frame<'a> {
     pub quality: Quality,
     /// The terrain, when the scene has one (none: nothing is marched).
     pub terrain: Option<&'a Heightfield>,
+    /// The physical sky's tables for this frame's sun and camera altitude
+    /// (`quality.atmosphere.sky_params()`; none: the analytic sky).
+    pub sky: Option<&'a SkyLuts>,
+}
+
+impl Frame<'_> {
+    /// What the sky functions read of this frame
+    /// ([`super::sky::SkyLight`]).
+    pub fn sky_light(&self) -> SkyLight<'_> {
+        SkyLight {
+            luts: self.sky,
+            aerial_perspective: self.quality.atmosphere.aerial_perspective,
+            haze_distance_m: self.quality.haze_distance_m,
+            camera_altitude_m: self.view.eye().y,
+        }
+    }
 }
 
 /// The result of marching one ray: linear radiance and the transmittance
@@ -99,11 +122,21 @@ pub const REFINE: u32 = 4;
 pub const SUN_INTENSITY: f32 = 8.0;
 
 /// The gain on the sky's light in cloud (`AMBIENT_GAIN` in WGSL):
-/// isotropic scattering of the upper sky's irradiance (`sky_radiance(up) /
-/// 4`), 0.35 of it at the band's bottom and all of it at its top, times
-/// this, which stands for the sky light's own multiple scattering; fitted
-/// with the octaves ([`super::lighting::sun_scattering`]).
+/// isotropic scattering of the upper sky's irradiance (`sky_above(up) /
+/// 4`), 0.35 of it at the band's bottom and all of it at its top, plus
+/// the ground's light from below (`ground_up / 4`), all of it at the
+/// bottom and 0.35 at the top ([`ambient_light`]), times this, which
+/// stands for that light's own multiple scattering; fitted with the
+/// octaves ([`super::lighting::sun_scattering`]).
 pub const AMBIENT_GAIN: f32 = 1.4;
+
+/// The sky's and the ground's light scattered at height fraction `eta` of
+/// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4` and the
+/// ground's `ground / 4` ([`AMBIENT_GAIN`]).
+#[inline]
+pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32) -> Vec3 {
+    (sky_top * (0.35 + 0.65 * eta) + ground * (1.0 - 0.65 * eta)) * AMBIENT_GAIN
+}
 
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
 /// in `[0, 1)` places the samples within their steps (0.5: centres);
@@ -114,6 +147,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     let d = &fr.density;
     let q = &fr.quality;
     let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let sky = &fr.sky_light();
     let hit = fr
         .terrain
         .and_then(|h| h.intersect(origin, dir, q.max_distance_m).map(|t| (h, t)));
@@ -124,6 +158,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
         ),
         None => (
             background_radiance(
+                sky,
                 dir,
                 sun_dir,
                 q.sea_wind_mps,
@@ -141,9 +176,12 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     };
     let steps = q.steps.max(1);
     let log_ratio = ((t1 + NEAR_M) / (t0 + NEAR_M)).ln();
-    let sun = sun_color(sun_dir) * SUN_INTENSITY;
-    // Irradiance from the upper sky (π L), scattered isotropically (1/4π).
-    let ambient_top = sky_radiance(Vec3::Y, sun_dir) * 0.25;
+    // The sun's light at the band's middle.
+    let sun = sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir);
+    // Irradiance from the upper sky and from the ground (π L), scattered
+    // isotropically (1/4π).
+    let sky_top = sky_ambient(sky, sun_dir) * 0.25;
+    let ground = ground_up(sky, sun_dir, q.sea_wind_mps.is_some()) * 0.25;
     let cos = dir.dot(sun_dir);
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
@@ -177,8 +215,9 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             }
             let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, footprint, &fr.fields, d);
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-            // Sky light from above, darker toward the cloud base.
-            let ambient = ambient_top * (AMBIENT_GAIN * (0.35 + 0.65 * eta));
+            // Sky light from above, darker toward the cloud base, and the
+            // ground's from below.
+            let ambient = ambient_light(sky_top, ground, eta);
             let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, q.octaves) + ambient;
             let s = scatter * (sigma_t * ALBEDO);
             let step_t = (-sigma_t * h).exp();
@@ -197,12 +236,8 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     } else {
         0.0
     };
-    let haze = (-cloud_distance / q.haze_distance_m.max(1.0)).exp();
-    let horizon = sky_radiance(
-        Vec3::new(dir.x, dir.y.max(0.0), dir.z).normalize_or(Vec3::Y),
-        sun_dir,
-    );
-    let clouds = light * haze + horizon * (opacity * (1.0 - haze));
+    let (inscatter, haze) = aerial(sky, dir, cloud_distance, sun_dir);
+    let clouds = light * haze + inscatter * opacity;
     RaySample {
         radiance: clouds + background * transmittance,
         clouds,
@@ -231,14 +266,14 @@ pub fn terrain_radiance(
     } else {
         1.0
     };
-    let sun = sun_color(sun_dir) * SUN_INTENSITY;
-    let sky = sky_radiance(Vec3::Y, sun_dir);
+    let light = &fr.sky_light();
+    let sun = sun_light_at(light, p.y, sun_dir);
+    let sky = sky_ambient(light, sun_dir);
     let lit = albedo
         * (sun * (n.dot(sun_dir).max(0.0) * shadow / std::f32::consts::PI)
             + sky * (0.5 + 0.5 * n.y));
-    let haze = (-t / fr.quality.haze_distance_m.max(1.0)).exp();
-    let horizon = sky_radiance(Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X), sun_dir);
-    lit * haze + horizon * (1.0 - haze)
+    let (inscatter, haze) = aerial(light, dir, t, sun_dir);
+    lit * haze + inscatter
 }
 
 /// The clouds' shadow where a ray that meets no terrain reaches the flat

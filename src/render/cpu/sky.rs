@@ -1,20 +1,126 @@
-//! An analytic sky: a blue gradient that pales toward the horizon, a
-//! forward-scattering glow and a disk around the sun, reddened when the sun
-//! is low; below the horizon the land, lit by the sun and the sky, or the
-//! sea. Not a physical sky model (`sky_luts` holds the tables of one, not
-//! yet read by the renderers), but smooth, cheap and the same on the GPU.
+//! The sky a frame is lit by, and the ground under it. Two models behind
+//! one set of functions (each the twin of the WGSL function of the same
+//! name; the GPU appends `shaders/sky_analytic.wgsl` or
+//! `shaders/sky_physical.wgsl`, so a scene's model is the only one
+//! compiled):
+//! - **physical** (the default): Hillaire 2020's atmosphere tables
+//!   ([`super::sky_luts`]): the sky's radiance from the sky-view table, the
+//!   sun's light through the transmittance table at the altitude it
+//!   reaches, aerial perspective marched through the tables, the
+//!   limb-darkened sun disk;
+//! - **analytic**: a blue gradient that pales toward the horizon, a glow
+//!   and a disk around the sun reddened by a fixed air mass, and an
+//!   exponential haze of `haze_distance_m`. Cheap, not physical.
+//!
+//! Below the horizon lies the land (lit by the sun through the clouds'
+//! shadow and by the sky) or the sea.
+
+use std::f32::consts::PI;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::lighting::phase_hg;
 use super::renderer::SUN_INTENSITY;
+use super::sky_luts::{
+    SkyLuts, SkyParams, aerial_perspective, sky_view_radiance, sun_disk_radiance, sun_radiance_at,
+};
 
-/// Cosine of the sun disk's angular radius (0.27°).
+/// Cosine of the analytic sun disk's angular radius (0.27°).
 pub const SUN_DISK_COS: f32 = 0.999_989;
 
-/// Colour of sunlight after the air mass for a sun at `sun_dir` (relative,
-/// ~1 at noon).
+/// Which sky model lights the scene (`[render.atmosphere] model`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SkyModel {
+    /// Hillaire 2020's tables: Rayleigh, Mie and ozone over a spherical
+    /// planet.
+    #[default]
+    Physical,
+    /// The analytic gradient and exponential haze.
+    Analytic,
+}
+
+/// The scene table `[render.atmosphere]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AtmosphereConfig {
+    /// `"physical"` or `"analytic"`. Default physical.
+    pub model: SkyModel,
+    /// Fade clouds and ground with distance (the physical model's march
+    /// through the air, or the analytic model's `haze_distance_m`).
+    /// Default true; off, the clouds are seen as in a vacuum (what the
+    /// path-traced comparison renders).
+    pub aerial_perspective: bool,
+    /// The aerosols' vertical optical depth at 550 nm (0..=3): 0.05 very
+    /// clean, 0.1-0.2 a clear continental or maritime day, 0.5 hazy, 1+
+    /// polluted. Their extinction falls off with Hillaire's Mie scale
+    /// height (1.2 km) and 0.91 of it scatters. The physical model only.
+    /// Default 0.15: a boundary layer that grows cumulus is seldom clean
+    /// (Hillaire's Earth has 0.005, a sky too deep a blue over ground too
+    /// dark).
+    pub aerosol_optical_depth: f32,
+}
+
+impl Default for AtmosphereConfig {
+    fn default() -> Self {
+        Self {
+            model: SkyModel::Physical,
+            aerial_perspective: true,
+            aerosol_optical_depth: 0.15,
+        }
+    }
+}
+
+impl AtmosphereConfig {
+    /// The physical model's atmosphere, `None` for the analytic model.
+    pub fn sky_params(&self) -> Option<SkyParams> {
+        (self.model == SkyModel::Physical).then(|| {
+            let base = SkyParams::default();
+            let extinction = self.aerosol_optical_depth / base.mie_scale_height_km;
+            let albedo = base.mie_scattering / base.mie_extinction;
+            SkyParams {
+                mie_scattering: extinction * albedo,
+                mie_extinction: extinction,
+                // The ground the sky's multiple scattering sees: the
+                // land's mean albedo.
+                ground_albedo: LAND_ALBEDO,
+                ..base
+            }
+        })
+    }
+}
+
+/// What the sky functions need of a frame: the model (the physical
+/// model's tables, built for this frame's sun and camera altitude) and the
+/// haze settings.
+#[derive(Debug, Clone, Copy)]
+pub struct SkyLight<'a> {
+    /// The physical model's tables; `None`: the analytic model.
+    pub luts: Option<&'a SkyLuts>,
+    /// Whether distance fades (`[render.atmosphere] aerial_perspective`).
+    pub aerial_perspective: bool,
+    /// The analytic model's haze distance, m.
+    pub haze_distance_m: f32,
+    /// The camera's altitude, m (where the physical model's aerial
+    /// perspective starts).
+    pub camera_altitude_m: f32,
+}
+
+impl SkyLight<'static> {
+    /// The analytic model with its haze at `haze_distance_m`.
+    pub fn analytic(haze_distance_m: f32) -> Self {
+        Self {
+            luts: None,
+            aerial_perspective: true,
+            haze_distance_m,
+            camera_altitude_m: 0.0,
+        }
+    }
+}
+
+/// Colour of sunlight after the analytic model's air mass for a sun at
+/// `sun_dir` (relative, ~1 at noon).
 #[inline]
 pub fn sun_color(sun_dir: Vec3) -> Vec3 {
     let air_mass = 1.0 / sun_dir.y.max(0.035);
@@ -22,14 +128,23 @@ pub fn sun_color(sun_dir: Vec3) -> Vec3 {
     Vec3::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp())
 }
 
-/// Sky radiance seen along `dir`, without the sun disk.
+/// The sun's irradiance (on a surface facing it) at `altitude_m`: the
+/// analytic model's `sun_color · SUN_INTENSITY` at any altitude, or the
+/// physical model's top-of-atmosphere irradiance through the
+/// transmittance table (0 once the sun has set at that altitude).
 #[inline]
-pub fn sky_radiance(dir: Vec3, sun_dir: Vec3) -> Vec3 {
+pub fn sun_light_at(sky: &SkyLight, altitude_m: f32, sun_dir: Vec3) -> Vec3 {
+    match sky.luts {
+        Some(luts) => sun_radiance_at(luts, altitude_m.max(0.0), sun_dir),
+        None => sun_color(sun_dir) * SUN_INTENSITY,
+    }
+}
+
+/// The analytic sky's radiance along `dir` (above the horizon).
+#[inline]
+pub fn analytic_sky(dir: Vec3, sun_dir: Vec3) -> Vec3 {
     let sun = sun_color(sun_dir);
     let day = sun_dir.y.clamp(0.0, 1.0).sqrt().max(0.15);
-    if dir.y < 0.0 {
-        return land_radiance(dir, sun_dir, 1.0);
-    }
     let zenith = Vec3::new(0.16, 0.32, 0.75);
     let horizon = Vec3::new(0.62, 0.72, 0.86);
     let f = (1.0 - dir.y).powi(4);
@@ -39,36 +154,143 @@ pub fn sky_radiance(dir: Vec3, sun_dir: Vec3) -> Vec3 {
     base + glow
 }
 
+/// The sky's radiance along `dir` at or above the horizon, without the
+/// sun disk: the analytic gradient, or the physical sky-view table.
+#[inline]
+pub fn sky_above(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    match sky.luts {
+        Some(luts) => sky_view_radiance(luts, dir, sun_dir),
+        None => analytic_sky(dir, sun_dir),
+    }
+}
+
+/// Directions of [`sky_ambient`]'s mean (inlined in WGSL): the zenith and
+/// four azimuths at 20° and at 55° elevation, as (cos, sin) of the
+/// elevation; the azimuths are 0°, 90°, 180°, 270° from north at 20° and
+/// 45°, 135°, 225°, 315° at 55°.
+pub const SKY_AMBIENT_ELEVATIONS: [(f32, f32); 2] =
+    [(0.939_692_6, 0.342_020_1), (0.573_576_4, 0.819_152)];
+
+/// The sky's light on a surface or into a cloud, as a radiance: what
+/// times π is the irradiance of level ground (the land's and terrain's
+/// sky light) and times 1/4 the cloud's isotropically scattered sky light
+/// at its top. Analytic: the zenith's radiance (its sky is nearly uniform;
+/// the ambient gain was fitted on it). Physical: the mean of nine
+/// directions ([`SKY_AMBIENT_ELEVATIONS`]), for its horizon is several
+/// times brighter than its zenith.
+#[inline]
+pub fn sky_ambient(sky: &SkyLight, sun_dir: Vec3) -> Vec3 {
+    if sky.luts.is_none() {
+        return sky_above(sky, Vec3::Y, sun_dir);
+    }
+    let mut sum = sky_above(sky, Vec3::Y, sun_dir);
+    for (k, (c, s)) in SKY_AMBIENT_ELEVATIONS.into_iter().enumerate() {
+        for i in 0..4 {
+            let a = (i as f32 + 0.5 * k as f32) * 0.5 * PI;
+            sum += sky_above(sky, Vec3::new(c * a.sin(), s, c * a.cos()), sun_dir);
+        }
+    }
+    sum / 9.0
+}
+
+/// Sky radiance seen along `dir`, without the sun disk; below the horizon
+/// the sunlit land.
+#[inline]
+pub fn sky_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    if dir.y < 0.0 {
+        return land_radiance(sky, dir, sun_dir, 1.0);
+    }
+    sky_above(sky, dir, sun_dir)
+}
+
+/// The horizon's sky in the azimuth of `dir`.
+#[inline]
+fn horizon_sky(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    sky_above(
+        sky,
+        Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X),
+        sun_dir,
+    )
+}
+
+/// The air between the camera and something `distance_m` away along
+/// `dir`: (the light it scatters toward the camera, its transmittance).
+/// Analytic: `exp(-distance / haze_distance)` of the sky at the horizon
+/// (at `dir`'s elevation when above it) in place of what it hides;
+/// physical: [`aerial_perspective`]'s march from the camera's altitude.
+/// `(0, 1)` with aerial perspective off.
+#[inline]
+pub fn aerial(sky: &SkyLight, dir: Vec3, distance_m: f32, sun_dir: Vec3) -> (Vec3, Vec3) {
+    if !sky.aerial_perspective {
+        return (Vec3::ZERO, Vec3::ONE);
+    }
+    match sky.luts {
+        Some(luts) => aerial_perspective(luts, sky.camera_altitude_m, dir, distance_m, sun_dir),
+        None => {
+            let haze = (-distance_m / sky.haze_distance_m.max(1.0)).exp();
+            let up = Vec3::new(dir.x, dir.y.max(0.0), dir.z).normalize_or(Vec3::Y);
+            (analytic_sky(up, sun_dir) * (1.0 - haze), Vec3::splat(haze))
+        }
+    }
+}
+
+/// The flat ground's `surface` radiance seen along `dir` (pointing down)
+/// through the air: analytic, faded into the horizon's sky within a few
+/// degrees of it; physical, [`aerial`] over the distance from the camera
+/// down to the ground (`camera_altitude_m / -dir.y`, so at grazing angles
+/// the air's own light).
+#[inline]
+pub fn ground_haze(sky: &SkyLight, surface: Vec3, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    let mu = (-dir.y).max(1e-4);
+    match sky.luts {
+        Some(_) => {
+            let (inscatter, t) = aerial(sky, dir, sky.camera_altitude_m.max(1.0) / mu, sun_dir);
+            surface * t + inscatter
+        }
+        None => surface.lerp(horizon_sky(sky, dir, sun_dir), (-mu * 40.0).exp()),
+    }
+}
+
 /// The flat land's albedo (inlined in WGSL's `land_radiance`): a muted
 /// green-brown of fields, woods and soil seen from afar, greyer than the
 /// terrain's grass (0.07 / 0.11 / 0.04 on level ground), which lit at
 /// full sun read as a lawn from the air.
 pub const LAND_ALBEDO: Vec3 = Vec3::new(0.08, 0.10, 0.06);
 
-/// The flat land seen along `dir` (pointing down) through the haze: a
-/// Lambertian [`LAND_ALBEDO`] lit as the terrain's level ground is, by the
-/// sun (its irradiance `SUN_INTENSITY · sun_color · sin(elevation)`,
-/// dimmed by the clouds' `shadow`, the transmittance toward the sun, 1:
+/// The flat land's own radiance (no haze): a Lambertian [`LAND_ALBEDO`]
+/// lit by the sun at the ground ([`sun_light_at`] times `sin(elevation)`,
+/// dimmed by the clouds' `shadow`, their transmittance toward the sun, 1:
 /// in the sun) and by the sky (the zenith's radiance standing for the
 /// sky's irradiance over π).
 #[inline]
-pub fn land_radiance(dir: Vec3, sun_dir: Vec3, shadow: f32) -> Vec3 {
-    let sun = sun_color(sun_dir) * SUN_INTENSITY;
-    let lit =
-        sun * (sun_dir.y.max(0.0) * shadow / std::f32::consts::PI) + sky_radiance(Vec3::Y, sun_dir);
-    let ground = LAND_ALBEDO * lit;
-    let horizon = sky_radiance(Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X), sun_dir);
-    let f = (-(-dir.y) * 40.0).exp();
-    ground.lerp(horizon, f)
+pub fn land_surface(sky: &SkyLight, sun_dir: Vec3, shadow: f32) -> Vec3 {
+    let sun = sun_light_at(sky, 0.0, sun_dir);
+    let lit = sun * (sun_dir.y.max(0.0) * shadow / PI) + sky_ambient(sky, sun_dir);
+    LAND_ALBEDO * lit
 }
 
-/// The sun disk's radiance along `dir` (0 off the disk).
+/// The flat land seen along `dir` (pointing down): [`land_surface`]
+/// through the air ([`ground_haze`]).
 #[inline]
-pub fn sun_disk(dir: Vec3, sun_dir: Vec3) -> Vec3 {
-    if dir.dot(sun_dir) > SUN_DISK_COS {
-        sun_color(sun_dir) * 60.0
-    } else {
-        Vec3::ZERO
+pub fn land_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, shadow: f32) -> Vec3 {
+    ground_haze(sky, land_surface(sky, sun_dir, shadow), dir, sun_dir)
+}
+
+/// The sun disk's radiance along `dir` (0 off the disk): analytic, a flat
+/// disk of 60 times the sun's colour; physical, the limb-darkened disk
+/// whose integral is the sun's irradiance at the camera
+/// ([`sun_disk_radiance`]).
+#[inline]
+pub fn sun_disk(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    match sky.luts {
+        Some(luts) => sun_disk_radiance(
+            dir,
+            sun_dir,
+            sun_light_at(sky, sky.camera_altitude_m, sun_dir),
+            luts.params.sun_angular_radius_deg.to_radians(),
+        ),
+        None if dir.dot(sun_dir) > SUN_DISK_COS => sun_color(sun_dir) * 60.0,
+        None => Vec3::ZERO,
     }
 }
 
@@ -131,6 +353,13 @@ pub fn fresnel_water(cos_i: f32) -> f32 {
     WATER_F0 + (1.0 - WATER_F0) * c * c * c * c * c
 }
 
+/// The water's own light (inlined in WGSL): a deep-blue albedo lit by
+/// the sun and the zenith sky, seen through the surface.
+#[inline]
+fn water_light(sky: &SkyLight, sun: Vec3, sun_dir: Vec3) -> Vec3 {
+    Vec3::new(0.004, 0.012, 0.02) * (sun * (sun_dir.y.max(0.0) / PI) + sky_ambient(sky, sun_dir))
+}
+
 /// Radiance of a wind-roughened sea seen along `dir` (pointing down):
 /// - the sky reflected by the mean flat surface, weighted by
 ///   [`fresnel_water`] (so the sea darkens looking down and mirrors the
@@ -141,31 +370,45 @@ pub fn fresnel_water(cos_i: f32) -> f32 {
 /// - the water's own light: a deep-blue albedo (0.004, 0.012, 0.02) lit
 ///   by the sun and the zenith sky, through the surface (1 - F);
 ///
-/// then faded into the horizon's haze as the land is ([`land_radiance`]).
-/// The clouds' `shadow` (transmittance toward the sun) dims the glint and
-/// the sunlit part of the water; clouds are not reflected.
+/// then seen through the air as the land is ([`ground_haze`]). The
+/// clouds' `shadow` (transmittance toward the sun) dims the glint and the
+/// sunlit part of the water; clouds are not reflected.
 #[inline]
-pub fn sea_radiance(dir: Vec3, sun_dir: Vec3, wind_mps: f32, shadow: f32) -> Vec3 {
+pub fn sea_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, wind_mps: f32, shadow: f32) -> Vec3 {
     let mu = (-dir.y).max(1e-3);
     let f = fresnel_water(mu);
-    let reflected = sky_radiance(Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y), sun_dir);
-    let sun = sun_color(sun_dir) * SUN_INTENSITY * shadow;
+    let reflected = sky_above(
+        sky,
+        Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y),
+        sun_dir,
+    );
+    let sun = sun_light_at(sky, 0.0, sun_dir) * shadow;
     let variance = 0.003 + 0.00512 * wind_mps.max(0.0);
     let h = (sun_dir - dir).normalize_or(Vec3::Y);
     let cos_b = h.y.max(1e-3);
     let cos2 = cos_b * cos_b;
-    let d =
-        (-(1.0 - cos2) / (cos2 * variance)).exp() / (std::f32::consts::PI * variance * cos2 * cos2);
+    let d = (-(1.0 - cos2) / (cos2 * variance)).exp() / (PI * variance * cos2 * cos2);
     let glint = if sun_dir.y > 0.0 {
         sun * (fresnel_water(h.dot(sun_dir)) * d / (4.0 * mu))
     } else {
         Vec3::ZERO
     };
-    let water = Vec3::new(0.004, 0.012, 0.02)
-        * (sun * (sun_dir.y.max(0.0) / std::f32::consts::PI) + sky_radiance(Vec3::Y, sun_dir));
-    let surface = reflected * f + glint + water * (1.0 - f);
-    let horizon = sky_radiance(Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::X), sun_dir);
-    surface.lerp(horizon, (-mu * 40.0).exp())
+    let surface = reflected * f + glint + water_light(sky, sun, sun_dir) * (1.0 - f);
+    ground_haze(sky, surface, dir, sun_dir)
+}
+
+/// The light that rises from the flat ground straight up, without the
+/// clouds' shadows (the sky irradiance of a cloud's underside that comes
+/// from below): the land's [`land_surface`], or the sea's reflected
+/// zenith and its own light (its glint is not seen from above).
+#[inline]
+pub fn ground_up(sky: &SkyLight, sun_dir: Vec3, sea: bool) -> Vec3 {
+    if sea {
+        let sun = sun_light_at(sky, 0.0, sun_dir);
+        let f = WATER_F0;
+        return sky_above(sky, Vec3::Y, sun_dir) * f + water_light(sky, sun, sun_dir) * (1.0 - f);
+    }
+    land_surface(sky, sun_dir, 1.0)
 }
 
 /// What a ray that meets no terrain sees along `dir`: the sky and the sun
@@ -174,17 +417,18 @@ pub fn sea_radiance(dir: Vec3, sun_dir: Vec3, wind_mps: f32, shadow: f32) -> Vec
 /// where the ray meets them.
 #[inline]
 pub fn background_radiance(
+    sky: &SkyLight,
     dir: Vec3,
     sun_dir: Vec3,
     sea_wind_mps: Option<f32>,
     shadow: f32,
 ) -> Vec3 {
     if dir.y >= 0.0 {
-        return sky_radiance(dir, sun_dir) + sun_disk(dir, sun_dir);
+        return sky_above(sky, dir, sun_dir) + sun_disk(sky, dir, sun_dir);
     }
     match sea_wind_mps {
-        Some(wind) => sea_radiance(dir, sun_dir, wind, shadow),
-        None => land_radiance(dir, sun_dir, shadow),
+        Some(wind) => sea_radiance(sky, dir, sun_dir, wind, shadow),
+        None => land_radiance(sky, dir, sun_dir, shadow),
     }
 }
 
@@ -211,17 +455,18 @@ mod tests {
     #[test]
     fn the_sea_mirrors_the_sky_and_glints_under_the_sun() {
         let sun = sun_direction(30.0, 180.0);
+        let a = &SkyLight::analytic(25_000.0);
         let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
         let at = |elev_deg: f32, az_deg: f32, wind: f32| {
             let d = -sun_direction(elev_deg, az_deg) * Vec3::new(-1.0, 1.0, -1.0);
-            sea_radiance(d.normalize(), sun, wind, 1.0)
+            sea_radiance(a, d.normalize(), sun, wind, 1.0)
         };
         // Away from the sun (azimuth 0), straight down and near the horizon.
         let down = lum(at(80.0, 0.0, 7.0));
-        let sky_up = lum(sky_radiance(Vec3::Y, sun));
+        let sky_up = lum(sky_radiance(a, Vec3::Y, sun));
         assert!(down < 0.2 * sky_up, "{down} {sky_up}");
         let near = at(0.5, 0.0, 7.0);
-        let horizon = sky_radiance(Vec3::new(0.0, 0.0, 1.0), sun);
+        let horizon = sky_radiance(a, Vec3::new(0.0, 0.0, 1.0), sun);
         assert!((lum(near) - lum(horizon)).abs() < 0.1 * lum(horizon));
         // The mirror image of the sun: 30° below the horizon toward it.
         let glint = lum(at(30.0, 180.0, 7.0));
@@ -236,22 +481,133 @@ mod tests {
         // cloud's shadow dims the glint.
         let up = Vec3::new(0.0, 0.5, 0.866);
         assert_eq!(
-            background_radiance(up, sun, Some(7.0), 0.0),
-            background_radiance(up, sun, None, 1.0)
+            background_radiance(a, up, sun, Some(7.0), 0.0),
+            background_radiance(a, up, sun, None, 1.0)
         );
         let d = Vec3::new(0.0, -0.5, 0.866);
         assert_ne!(
-            background_radiance(d, sun, Some(7.0), 1.0),
-            background_radiance(d, sun, None, 1.0)
+            background_radiance(a, d, sun, Some(7.0), 1.0),
+            background_radiance(a, d, sun, None, 1.0)
         );
         let g = -sun * Vec3::new(-1.0, 1.0, -1.0);
-        let shaded = lum(sea_radiance(g, sun, 7.0, 0.1));
+        let shaded = lum(sea_radiance(a, g, sun, 7.0, 0.1));
         assert!(shaded < 0.2 * glint, "{shaded} {glint}");
         // The land in a cloud's shadow is darker by the sun's part, and
         // keeps the sky's: on a clear day the sky gives 10-30 % of the
         // irradiance on level ground at a 30° sun.
-        let (lit, dark) = (land_radiance(d, sun, 1.0), land_radiance(d, sun, 0.0));
+        let (lit, dark) = (land_radiance(a, d, sun, 1.0), land_radiance(a, d, sun, 0.0));
         let ratio = lum(dark) / lum(lit);
         assert!((0.1..0.3).contains(&ratio), "{ratio}");
+    }
+}
+
+#[cfg(test)]
+mod physical_tests {
+    use super::*;
+
+    fn luts(sun_elevation_deg: f32, altitude_m: f32) -> (SkyLuts, Vec3) {
+        let sun = sun_direction(sun_elevation_deg, 135.0);
+        let params = AtmosphereConfig::default().sky_params().expect("physical");
+        (SkyLuts::build(params, sun, altitude_m), sun)
+    }
+
+    fn light(luts: &SkyLuts) -> SkyLight<'_> {
+        SkyLight {
+            luts: Some(luts),
+            aerial_perspective: true,
+            haze_distance_m: 25_000.0,
+            camera_altitude_m: luts.camera_altitude_m,
+        }
+    }
+
+    /// The sun's light through the air follows its elevation: nearly
+    /// white at noon (blue within 20 % of red), golden near the horizon
+    /// (red at least twice blue at 5°, and dimmer), gone once it has set;
+    /// the analytic model's air mass does the same but never sets.
+    #[test]
+    fn sunlight_warms_as_the_sun_sinks_and_goes_at_sunset() {
+        let at = |e: f32| {
+            let (l, sun) = luts(e, 1000.0);
+            sun_light_at(&light(&l), 1500.0, sun)
+        };
+        let noon = at(80.0);
+        assert!(noon.z > 0.8 * noon.x && noon.x < 8.0, "{noon}");
+        let low = at(5.0);
+        assert!(low.x > 2.0 * low.z && low.y < 0.8 * noon.y, "{low}");
+        let set = at(-3.0);
+        assert!(set.max_element() < 1e-3, "{set}");
+    }
+
+    /// The sky is blue overhead and paler toward the horizon at noon;
+    /// distance fades things toward the horizon's light (a black ground
+    /// 30 km off takes most of its light from the air, one 1 km off a
+    /// little); with aerial perspective off nothing fades.
+    #[test]
+    fn the_sky_is_blue_and_distance_fades_into_it() {
+        let (l, sun) = luts(60.0, 500.0);
+        let s = &light(&l);
+        let zenith = sky_above(s, Vec3::Y, sun);
+        assert!(zenith.z > 1.5 * zenith.x, "{zenith}");
+        let horizon = sky_above(s, Vec3::new(0.0, 0.02, -1.0).normalize(), sun);
+        assert!(
+            horizon.x / horizon.z > zenith.x / zenith.z,
+            "{horizon} {zenith}"
+        );
+        let dir = Vec3::new(0.0, -0.01, -1.0).normalize();
+        let (far, t_far) = aerial(s, dir, 30_000.0, sun);
+        let (near, t_near) = aerial(s, dir, 1_000.0, sun);
+        assert!(t_far.y < 0.5 && t_near.y > 0.85, "{t_far} {t_near}");
+        assert!(far.y > 4.0 * near.y, "{far} {near}");
+        let off = SkyLight {
+            aerial_perspective: false,
+            ..*s
+        };
+        assert_eq!(aerial(&off, dir, 30_000.0, sun), (Vec3::ZERO, Vec3::ONE));
+        // The sky's mean light exceeds the zenith's (the horizon is brighter).
+        assert!(sky_ambient(s, sun).y > zenith.y);
+    }
+
+    /// The limb-darkened disk carries the sun's irradiance at the camera:
+    /// its integral over the disk (a fine grid of directions) is that
+    /// irradiance within 2 %, and its centre is brighter than its edge.
+    #[test]
+    fn the_sun_disk_integrates_to_the_suns_irradiance() {
+        let (l, sun) = luts(30.0, 0.0);
+        let s = &light(&l);
+        let e = sun_light_at(s, 0.0, sun);
+        let radius = l.params.sun_angular_radius_deg.to_radians();
+        let (u, v) = (
+            sun.cross(Vec3::Y).normalize(),
+            sun.cross(sun.cross(Vec3::Y)).normalize(),
+        );
+        let n = 200;
+        let h = 2.4 * radius / n as f32;
+        let mut sum = Vec3::ZERO;
+        for i in 0..n {
+            for j in 0..n {
+                let (x, y) = (
+                    (i as f32 + 0.5) * h - 1.2 * radius,
+                    (j as f32 + 0.5) * h - 1.2 * radius,
+                );
+                let d = (sun + u * x + v * y).normalize();
+                sum += sun_disk(s, d, sun) * h * h;
+            }
+        }
+        assert!((sum.y / e.y - 1.0).abs() < 0.02, "{sum} {e}");
+        let edge = sun_disk(s, (sun + u * 0.95 * radius).normalize(), sun);
+        assert!(edge.y < 0.75 * sun_disk(s, sun, sun).y);
+    }
+
+    /// Clouds' undersides see the ground: land sends up its sunlit albedo
+    /// (brighter under a higher sun), the sea much less.
+    #[test]
+    fn the_ground_lights_from_below() {
+        let (l, sun) = luts(60.0, 100.0);
+        let s = &light(&l);
+        let land = ground_up(s, sun, false);
+        let sea = ground_up(s, sun, true);
+        assert!(land.y > 3.0 * sea.y && sea.y > 0.0, "{land} {sea}");
+        let (l5, sun5) = luts(5.0, 100.0);
+        assert!(ground_up(&light(&l5), sun5, false).y < 0.5 * land.y);
     }
 }

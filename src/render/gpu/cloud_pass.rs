@@ -60,10 +60,11 @@ impl CloudPass {
         constants: &[(&str, f64)],
         depth: bool,
         tsaa: bool,
+        physical: bool,
     ) -> &wgpu::RenderPipeline {
         let (depth_layout, no_depth_layout) = (&self.depth_layout, &self.no_depth_layout);
         self.pipelines[depth as usize].get_or_insert_with(|| {
-            let module = bind::module(device, "clouds", shaders::cloud_pass(depth, tsaa));
+            let module = bind::module(device, "clouds", shaders::cloud_pass(depth, tsaa, physical));
             let group1 = if depth { depth_layout } else { no_depth_layout };
             let mut targets = vec![Some(CLOUD_FORMAT.into())];
             if tsaa {
@@ -108,6 +109,7 @@ impl CloudPass {
                 constants,
                 depth.is_some(),
                 distance.is_some(),
+                inputs.sky.is_some(),
             )
             .clone();
         let clear = Some(wgpu::Color::TRANSPARENT);

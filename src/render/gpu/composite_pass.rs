@@ -45,6 +45,7 @@ impl CompositePass {
         constants: &[(&str, f64)],
         target_format: wgpu::TextureFormat,
         background: Background,
+        physical: bool,
     ) -> usize {
         if let Some(i) = self.pipelines.iter().position(|(b, _, _)| *b == background) {
             return i;
@@ -58,7 +59,11 @@ impl CompositePass {
             }
         }
         let layout = bind::layout(device, "composite.group1", &entries);
-        let module = bind::module(device, "composite", shaders::composite_pass(background));
+        let module = bind::module(
+            device,
+            "composite",
+            shaders::composite_pass(background, physical),
+        );
         let blend = (background == Background::ExternalDepth)
             .then_some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
         let encode = if target_format.is_srgb() { 0.0 } else { 1.0 };
@@ -103,6 +108,7 @@ impl CompositePass {
             constants,
             target.texture().format(),
             background,
+            inputs.sky.is_some(),
         );
         let mut resources = vec![wgpu::BindingResource::TextureView(clouds)];
         resources.extend(behind.map(wgpu::BindingResource::TextureView));

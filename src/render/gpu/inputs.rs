@@ -1,13 +1,20 @@
 //! Bind group 0, the inputs every pass reads: the frame's uniform block,
 //! P, the cloud map (with mips), the coverage mask of P, the wrapping
-//! sampler, the 3D detail volume (with mips) and the blue-noise tile.
+//! sampler, the 3D detail volume (with mips) and the blue-noise tile; under
+//! the physical sky also the atmosphere's params and its three tables
+//! (bindings 7 to 10, built by [`SkyLutsPass`]; absent under the analytic
+//! sky).
+
+use glam::Vec3;
 
 use std::sync::Arc;
 
 use super::bind::{self, FILTERABLE, UNFILTERABLE};
+use super::sky_luts_pass::{SkyLutsPass, SkyTable};
 use super::textures;
 use crate::render::cloud_map::CloudMap;
 use crate::render::coverage_mask::CoverageMask;
+use crate::render::cpu::sky_luts::SkyParams;
 use crate::render::noise_volume::NoiseVolume;
 use crate::sim::ProjectedField;
 
@@ -32,31 +39,26 @@ pub struct Inputs {
     pub mask_info: [u32; 4],
     /// Texels per side of the cloud map.
     pub map_size: u32,
+    /// The physical sky's tables (none: the analytic sky).
+    pub sky: Option<SkyLutsPass>,
 }
 
 impl Inputs {
     /// The inputs with `cloud_map` uploaded (its detail volume only with
-    /// `detail`) and an empty P (clear sky).
+    /// `detail`), an empty P (clear sky), and with `sky` the physical
+    /// sky's tables for the sun at `sun_dir` (the sky view for a camera on
+    /// the ground until the first frame).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         cloud_map: &CloudMap,
         detail: bool,
+        sky: Option<&SkyParams>,
+        sun_dir: Vec3,
     ) -> Self {
         let uniforms = bind::uniform_buffer(device, "clouds.frame_uniforms");
-        let layout = bind::layout(
-            device,
-            "clouds.group0",
-            &[
-                bind::uniform_entry(0),
-                bind::texture_entry(1, FILTERABLE),
-                bind::texture_entry(2, FILTERABLE),
-                bind::texture_entry(3, wgpu::TextureSampleType::Uint),
-                bind::sampler_entry(4),
-                bind::texture_3d_entry(5, FILTERABLE),
-                bind::texture_entry(6, UNFILTERABLE),
-            ],
-        );
+        let sky = sky.map(|p| SkyLutsPass::with_device(device, queue, p, sun_dir, 0.0));
+        let layout = group0_layout(device, sky.is_some());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("clouds.wrap_linear"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -89,6 +91,7 @@ impl Inputs {
             &[&p_texture, &cloud_map, &mask_texture, &noise, &blue_noise],
             &uniforms,
             &sampler,
+            sky.as_ref(),
         );
         Self {
             uniforms,
@@ -105,6 +108,35 @@ impl Inputs {
             mask: mask_texture,
             mask_info: [1, 1, mask.cell as u32, 0],
             map_size,
+            sky,
+        }
+    }
+
+    /// Switches between the physical sky (`Some`: its tables built, or
+    /// rebuilt where the params changed) and the analytic one; whether the
+    /// layout changed (the passes' pipelines must then be rebuilt).
+    pub fn set_sky(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        sky: Option<&SkyParams>,
+        sun_dir: Vec3,
+        camera_altitude_m: f32,
+    ) -> bool {
+        match (sky, &mut self.sky) {
+            (Some(p), Some(pass)) => {
+                pass.update(device, queue, p, sun_dir, camera_altitude_m);
+                false
+            }
+            (None, None) => false,
+            (p, _) => {
+                self.sky = p.map(|p| {
+                    SkyLutsPass::with_device(device, queue, p, sun_dir, camera_altitude_m)
+                });
+                self.layout = group0_layout(device, self.sky.is_some());
+                self.rebind(device);
+                true
+            }
         }
     }
 
@@ -193,8 +225,31 @@ impl Inputs {
             ],
             &self.uniforms,
             &self.sampler,
+            self.sky.as_ref(),
         );
     }
+}
+
+/// Group 0's layout, with the physical sky's bindings when `sky`.
+fn group0_layout(device: &wgpu::Device, sky: bool) -> wgpu::BindGroupLayout {
+    let mut entries = vec![
+        bind::uniform_entry(0),
+        bind::texture_entry(1, FILTERABLE),
+        bind::texture_entry(2, FILTERABLE),
+        bind::texture_entry(3, wgpu::TextureSampleType::Uint),
+        bind::sampler_entry(4),
+        bind::texture_3d_entry(5, FILTERABLE),
+        bind::texture_entry(6, UNFILTERABLE),
+    ];
+    if sky {
+        entries.extend([
+            bind::uniform_entry(7),
+            bind::texture_entry(8, UNFILTERABLE),
+            bind::texture_entry(9, UNFILTERABLE),
+            bind::texture_entry(10, UNFILTERABLE),
+        ]);
+    }
+    bind::layout(device, "clouds.group0", &entries)
 }
 
 /// Group 0 over `textures` (P, cloud map, mask, detail volume, blue
@@ -205,20 +260,22 @@ fn group0(
     textures: &[&wgpu::Texture; 5],
     uniforms: &wgpu::Buffer,
     sampler: &wgpu::Sampler,
+    sky: Option<&SkyLutsPass>,
 ) -> wgpu::BindGroup {
     let [p, cloud_map, mask, noise, blue] = textures.map(bind::view);
-    bind::bind(
-        device,
-        "clouds.group0",
-        layout,
-        &[
-            uniforms.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&p),
-            wgpu::BindingResource::TextureView(&cloud_map),
-            wgpu::BindingResource::TextureView(&mask),
-            wgpu::BindingResource::Sampler(sampler),
-            wgpu::BindingResource::TextureView(&noise),
-            wgpu::BindingResource::TextureView(&blue),
-        ],
-    )
+    let tables = sky.map(|s| SkyTable::ALL.map(|t| bind::view(s.texture(t))));
+    let mut resources = vec![
+        uniforms.as_entire_binding(),
+        wgpu::BindingResource::TextureView(&p),
+        wgpu::BindingResource::TextureView(&cloud_map),
+        wgpu::BindingResource::TextureView(&mask),
+        wgpu::BindingResource::Sampler(sampler),
+        wgpu::BindingResource::TextureView(&noise),
+        wgpu::BindingResource::TextureView(&blue),
+    ];
+    if let (Some(s), Some(tables)) = (sky, &tables) {
+        resources.push(s.params_buffer().as_entire_binding());
+        resources.extend(tables.iter().map(wgpu::BindingResource::TextureView));
+    }
+    bind::bind(device, "clouds.group0", layout, &resources)
 }

@@ -27,6 +27,7 @@ pub use super::composite_pass::PASS_COMPOSITE;
 use super::inputs::Inputs;
 use super::settings::GpuSettings;
 use super::shaders::Background;
+use super::sky_luts_pass::{SkyTable, TableBuilds};
 pub use super::terrain_pass::PASS_TERRAIN;
 use super::terrain_pass::TerrainPass;
 /// The format of [`CloudRenderer::render_clouds`]'s texture.
@@ -146,12 +147,19 @@ impl CloudRenderer {
         cloud_map: &CloudMap,
         terrain: Option<&Heightfield>,
     ) -> Self {
-        let inputs = Inputs::new(device, queue, cloud_map, settings.detail());
+        let sky = settings.sky_params();
+        let inputs = Inputs::new(
+            device,
+            queue,
+            cloud_map,
+            settings.detail(),
+            sky.as_ref(),
+            settings.sun_dir(),
+        );
         let constants = settings.constants();
         let size = (0, 0);
         Self {
-            terrain: terrain
-                .map(|h| TerrainPass::new(device, queue, &inputs.layout, &constants, h, size)),
+            terrain: terrain.map(|h| TerrainPass::new(device, queue, &inputs, &constants, h, size)),
             clouds: CloudPass::new(device, size.0, size.1),
             tsaa: settings
                 .tsaa
@@ -187,14 +195,7 @@ impl CloudRenderer {
         let constants = self.settings.constants();
         let size = (self.width, self.height);
         self.terrain = terrain.map(|h| {
-            TerrainPass::new(
-                &self.device,
-                &self.queue,
-                &self.inputs.layout,
-                &constants,
-                h,
-                size,
-            )
+            TerrainPass::new(&self.device, &self.queue, &self.inputs, &constants, h, size)
         });
         self.clouds.invalidate();
     }
@@ -208,7 +209,19 @@ impl CloudRenderer {
     /// (on first use), TSAA's pass and textures are created or dropped.
     pub fn set_settings(&mut self, settings: &GpuSettings) {
         let old = std::mem::replace(&mut self.settings, *settings);
-        let constants_changed = old.constants() != settings.constants();
+        let queue = self.queue.clone();
+        // The physical sky's tables: rebuilt when its params change; its
+        // bindings added or removed (every pipeline rebuilt) when the model
+        // changes.
+        let altitude = self.prev_view.map_or(0.0, |v| v.eye().y);
+        let layout_changed = self.inputs.set_sky(
+            &self.device,
+            &queue,
+            settings.sky_params().as_ref(),
+            settings.sun_dir(),
+            altitude,
+        );
+        let constants_changed = old.constants() != settings.constants() || layout_changed;
         let tsaa_changed = old.tsaa.is_some() != settings.tsaa.is_some();
         if constants_changed || tsaa_changed {
             self.clouds.invalidate();
@@ -223,11 +236,10 @@ impl CloudRenderer {
         } else if let (Some(t), Some(s)) = (&mut self.tsaa, settings.tsaa) {
             t.settings = s;
         }
-        let queue = self.queue.clone();
         self.inputs
             .set_detail(&self.device, &queue, settings.detail());
         if constants_changed && let Some(t) = &mut self.terrain {
-            t.rebuild_pipeline(&self.device, &self.inputs.layout, &constants);
+            t.rebuild_pipeline(&self.device, &self.inputs, &constants);
         }
         // The spread is in metres: a new map extent spreads P anew.
         if old.density.map_extent_m != settings.density.map_extent_m
@@ -320,6 +332,13 @@ impl CloudRenderer {
         v
     }
 
+    /// The physical sky's table builds since the renderer was made, per
+    /// table (`None` under the analytic sky): a still camera under a still
+    /// sun builds nothing after its first frame.
+    pub fn sky_table_builds(&self) -> Option<TableBuilds> {
+        self.inputs.sky.as_ref().map(|s| s.builds())
+    }
+
     /// The textures that exist now, by label.
     pub fn textures(&self) -> Vec<&'static str> {
         let mut v = vec![
@@ -337,6 +356,9 @@ impl CloudRenderer {
         }
         if self.terrain.is_some() {
             v.extend(["terrain.heights", "terrain.color", "terrain.depth"]);
+        }
+        if self.inputs.sky.is_some() {
+            v.extend(SkyTable::ALL.map(SkyTable::label));
         }
         v
     }
@@ -538,6 +560,13 @@ impl CloudRenderer {
     /// reads the terrain's depth buffer (stored flipped under reversed
     /// depth).
     fn write_uniforms(&mut self, view: &View, own_depth: bool) {
+        if let Some(sky) = &mut self.inputs.sky {
+            // The sky view for this camera's altitude, submitted now (before
+            // the caller's encoder); nothing is built unless the sun's
+            // elevation or the camera's altitude changed.
+            let sun_dir = self.settings.sun_dir();
+            sky.update_sky_view(&self.device, &self.queue, sun_dir, view.eye().y);
+        }
         let cut = self.prev_view.is_none_or(|p| is_cut(&p, view));
         let (jit, blend) = match &mut self.tsaa {
             Some(t) => {

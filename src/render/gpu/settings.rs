@@ -1,9 +1,13 @@
 //! [`GpuSettings`]: what the wgpu renderer draws and how well, and the
 //! WGSL `override` constants they compile to.
 
+use glam::Vec3;
+
 use super::tsaa::TsaaSettings;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::Quality;
+use crate::render::cpu::sky::sun_direction;
+use crate::render::cpu::sky_luts::SkyParams;
 
 /// What the renderer draws and how well. Changing it with
 /// [`CloudRenderer::set_settings`] rebuilds only what changed.
@@ -28,6 +32,16 @@ impl GpuSettings {
         self.density.detail_strength > 0.0
     }
 
+    /// The physical sky's atmosphere (`None`: the analytic sky).
+    pub fn sky_params(&self) -> Option<SkyParams> {
+        self.quality.atmosphere.sky_params()
+    }
+
+    /// Unit vector toward the sun.
+    pub fn sun_dir(&self) -> Vec3 {
+        sun_direction(self.sun_elevation_deg, self.sun_azimuth_deg)
+    }
+
     /// Values of the WGSL `override` constants (`shaders/clouds.wgsl`) for
     /// these settings: a feature that is off is compiled out.
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
@@ -38,6 +52,10 @@ impl GpuSettings {
             ("DETAIL", flag(self.detail())),
             ("DEBUG_COUNT", flag(self.debug_sample_count)),
             ("SEA", flag(self.quality.sea_wind_mps.is_some())),
+            (
+                "AERIAL_PERSPECTIVE",
+                flag(self.quality.atmosphere.aerial_perspective),
+            ),
             (
                 "SEA_WIND_MPS",
                 self.quality.sea_wind_mps.unwrap_or_default() as f64,

@@ -1,6 +1,8 @@
 //! WGSL sources, assembled per variant. `shaders/clouds.wgsl` holds the
-//! shared functions (the twins of `render::cpu`); each pass appends its own
-//! file, and the variant's bindings and entry point are appended here, so a
+//! shared functions (the twins of `render::cpu`), then the sky model's
+//! file (`sky_analytic.wgsl`, or `sky_luts.wgsl` and `sky_physical.wgsl`
+//! with the atmosphere tables' bindings); each pass appends its own file,
+//! and the variant's bindings and entry point are appended here, so a
 //! feature a scene does not use has no binding, no output and no code.
 
 /// The shared functions and the frame uniform block.
@@ -11,15 +13,32 @@ pub const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
 pub const TSAA: &str = include_str!("../../../shaders/tsaa.wgsl");
 /// The terrain pass.
 pub const TERRAIN: &str = include_str!("../../../shaders/terrain.wgsl");
-/// The sky tables' compute passes (standalone: not assembled with
-/// [`CLOUDS`]).
+/// The sky tables' functions (a library: no bindings, no entry points).
 pub const SKY_LUTS: &str = include_str!("../../../shaders/sky_luts.wgsl");
+/// The sky tables' compute entry points (after [`SKY_LUTS`]).
+pub const SKY_LUTS_BUILD: &str = include_str!("../../../shaders/sky_luts_build.wgsl");
+/// The analytic sky's functions (after [`CLOUDS`]).
+pub const SKY_ANALYTIC: &str = include_str!("../../../shaders/sky_analytic.wgsl");
+/// The physical sky's functions and table bindings (after [`CLOUDS`] and
+/// [`SKY_LUTS`]).
+pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl");
+
+/// The shared functions with the sky model's: the physical atmosphere's
+/// tables (bindings 7 to 10 of group 0) when `physical`, else the
+/// analytic sky.
+pub fn shared(physical: bool) -> String {
+    if physical {
+        format!("{CLOUDS}\n{SKY_LUTS}\n{SKY_PHYSICAL}\n")
+    } else {
+        format!("{CLOUDS}\n{SKY_ANALYTIC}\n")
+    }
+}
 
 /// The cloud pass's source: marches to the depth buffer's surface when
 /// `depth`, and writes the cloud distance for the TSAA reprojection when
-/// `tsaa`.
-pub fn cloud_pass(depth: bool, tsaa: bool) -> String {
-    let mut s = String::from(CLOUDS);
+/// `tsaa`, under the physical sky when `physical`.
+pub fn cloud_pass(depth: bool, tsaa: bool, physical: bool) -> String {
+    let mut s = shared(physical);
     if depth {
         s.push_str("\n@group(1) @binding(0) var depth_tex: texture_depth_2d;\n");
     }
@@ -62,9 +81,10 @@ pub enum Background {
     ExternalDepth,
 }
 
-/// The composite pass's source for `background`.
-pub fn composite_pass(background: Background) -> String {
-    let mut s = format!("{CLOUDS}\n{COMPOSITE}\n");
+/// The composite pass's source for `background`, under the physical sky
+/// when `physical`.
+pub fn composite_pass(background: Background, physical: bool) -> String {
+    let mut s = format!("{}{COMPOSITE}\n", shared(physical));
     match background {
         Background::Sky => s.push_str(
             "@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);\n}\n",
@@ -79,47 +99,51 @@ pub fn composite_pass(background: Background) -> String {
     s
 }
 
-/// The TSAA pass's source.
+/// The TSAA pass's source (it reads no sky: the analytic file only
+/// completes the shared functions).
 pub fn tsaa_pass() -> String {
-    format!("{CLOUDS}\n{TSAA}")
+    format!("{}{TSAA}", shared(false))
 }
 
-/// The terrain pass's source.
-pub fn terrain_pass() -> String {
-    format!("{CLOUDS}\n{TERRAIN}")
+/// The terrain pass's source, under the physical sky when `physical`.
+pub fn terrain_pass(physical: bool) -> String {
+    format!("{}{TERRAIN}", shared(physical))
 }
 
-/// The per-parcel baseline's source (`cumulus bench` only).
+/// The per-parcel baseline's source (`cumulus bench` only; its one bind
+/// group 0 holds the uniforms alone, so it draws under the analytic sky).
 pub fn baseline_pass() -> String {
-    format!("{CLOUDS}\n{COMPOSITE}\n{}", super::baseline::BASELINE)
+    format!(
+        "{}{COMPOSITE}\n{}",
+        shared(false),
+        super::baseline::BASELINE
+    )
 }
 
 /// The sky tables' source: three compute entry points.
 pub fn sky_luts_pass() -> String {
-    SKY_LUTS.to_string()
+    format!("{SKY_LUTS}\n{SKY_LUTS_BUILD}")
 }
 
-/// Every variant's source: the cloud pass with and without depth and
-/// TSAA, the composite pass over each background, TSAA, terrain, the
-/// baseline and the sky tables.
+/// Every variant's source: under each sky model, the cloud pass with and
+/// without depth and TSAA, the composite pass over each background and
+/// the terrain; TSAA, the baseline and the sky tables.
 pub fn all_variants() -> Vec<String> {
-    let mut sources = vec![
-        tsaa_pass(),
-        terrain_pass(),
-        baseline_pass(),
-        sky_luts_pass(),
-    ];
-    for depth in [false, true] {
-        for tsaa in [false, true] {
-            sources.push(cloud_pass(depth, tsaa));
+    let mut sources = vec![tsaa_pass(), baseline_pass(), sky_luts_pass()];
+    for physical in [false, true] {
+        sources.push(terrain_pass(physical));
+        for depth in [false, true] {
+            for tsaa in [false, true] {
+                sources.push(cloud_pass(depth, tsaa, physical));
+            }
         }
-    }
-    for b in [
-        Background::Sky,
-        Background::Terrain,
-        Background::ExternalDepth,
-    ] {
-        sources.push(composite_pass(b));
+        for b in [
+            Background::Sky,
+            Background::Terrain,
+            Background::ExternalDepth,
+        ] {
+            sources.push(composite_pass(b, physical));
+        }
     }
     sources
 }

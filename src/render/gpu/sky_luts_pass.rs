@@ -4,7 +4,9 @@
 //! multiple-scattering tables are rebuilt only when the [`SkyParams`]
 //! change, the sky view only when they or its inputs (the sun's elevation,
 //! the camera's altitude) do: the pass keeps the last inputs and skips a
-//! build whose inputs are equal. Not yet read by the renderer's passes.
+//! build whose inputs are equal. The renderer's passes read the tables
+//! under the physical sky (`shaders/sky_physical.wgsl`, bindings 7 to 10
+//! of group 0, [`super::inputs`]).
 
 use glam::Vec3;
 
@@ -167,8 +169,13 @@ fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
     ]
 }
 
-fn buffer(ctx: &GpuContext, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
-    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+fn buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size,
         usage,
@@ -193,19 +200,34 @@ impl SkyLutsPass {
         sun_dir: Vec3,
         camera_altitude_m: f32,
     ) -> Result<Self, GpuError> {
-        let mut pass = ctx.checked(|| Self::create(ctx, params))?;
+        let mut pass = ctx.checked(|| Self::create(&ctx.device, ctx.timestamps, params))?;
         let view = view_inputs(params, sun_dir, camera_altitude_m);
-        pass.full_build(ctx, params, view)?;
+        ctx.checked(|| pass.full_build(&ctx.device, &ctx.queue, params, view))?;
         Ok(pass)
     }
 
-    fn create(ctx: &GpuContext, params: &SkyParams) -> Self {
-        let device = &ctx.device;
+    /// [`Self::new`] on an application's device (no error scope, no
+    /// timestamps): the tables the renderer's passes read under the
+    /// physical sky, built now.
+    pub fn with_device(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        params: &SkyParams,
+        sun_dir: Vec3,
+        camera_altitude_m: f32,
+    ) -> Self {
+        let mut pass = Self::create(device, false, params);
+        let view = view_inputs(params, sun_dir, camera_altitude_m);
+        pass.full_build(device, queue, params, view);
+        pass
+    }
+
+    fn create(device: &wgpu::Device, timestamps: bool, params: &SkyParams) -> Self {
         let uniform_usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let params_size = size_of::<SkyParamsUniforms>() as u64;
-        let params_buffer = buffer(ctx, "sky_luts.params", params_size, uniform_usage);
+        let params_buffer = buffer(device, "sky_luts.params", params_size, uniform_usage);
         let view_size = size_of::<SkyViewUniforms>() as u64;
-        let view_buffer = buffer(ctx, "sky_luts.view", view_size, uniform_usage);
+        let view_buffer = buffer(device, "sky_luts.view", view_size, uniform_usage);
         let textures = SkyTable::ALL.map(|t| {
             let usage = wgpu::TextureUsages::STORAGE_BINDING
                 | wgpu::TextureUsages::TEXTURE_BINDING
@@ -238,20 +260,20 @@ impl SkyLutsPass {
             (pipeline, group)
         });
         let [(p0, g0), (p1, g1), (p2, g2)] = pipelines_and_groups;
-        let timestamps = ctx.timestamps.then(|| Timestamps {
+        let timestamps = timestamps.then(|| Timestamps {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("sky_luts.timestamps"),
                 ty: wgpu::QueryType::Timestamp,
                 count: 6,
             }),
             resolve: buffer(
-                ctx,
+                device,
                 "sky_luts.timestamps.resolve",
                 3 * RESOLVE_STRIDE,
                 wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             ),
             readback: buffer(
-                ctx,
+                device,
                 "sky_luts.timestamps.readback",
                 3 * RESOLVE_STRIDE,
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
@@ -287,33 +309,45 @@ impl SkyLutsPass {
         sun_dir: Vec3,
         camera_altitude_m: f32,
     ) -> Result<TableBuilds, GpuError> {
+        ctx.checked(|| self.update(&ctx.device, &ctx.queue, params, sun_dir, camera_altitude_m))
+    }
+
+    /// [`Self::build_all`] on an application's device (no error scope).
+    pub fn update(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        params: &SkyParams,
+        sun_dir: Vec3,
+        camera_altitude_m: f32,
+    ) -> TableBuilds {
         if *params == self.last.params {
-            return self.rebuild_sky_view(ctx, sun_dir, camera_altitude_m);
+            return self.update_sky_view(device, queue, sun_dir, camera_altitude_m);
         }
-        self.full_build(ctx, params, view_inputs(params, sun_dir, camera_altitude_m))
+        let view = view_inputs(params, sun_dir, camera_altitude_m);
+        self.full_build(device, queue, params, view)
     }
 
     fn full_build(
         &mut self,
-        ctx: &GpuContext,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
         params: &SkyParams,
         view: SkyViewUniforms,
-    ) -> Result<TableBuilds, GpuError> {
+    ) -> TableBuilds {
         let block = SkyParamsUniforms::new(params);
-        ctx.queue
-            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&block));
-        ctx.queue
-            .write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&view));
-        self.encode(ctx, [true; 3])?;
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&block));
+        queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&view));
+        self.encode(device, queue, [true; 3]);
         self.last = Inputs {
             params: *params,
             view,
         };
-        Ok(self.count(TableBuilds {
+        self.count(TableBuilds {
             transmittance: 1,
             multi_scattering: 1,
             sky_view: 1,
-        }))
+        })
     }
 
     /// Rebuilds the sky view for a new sun or camera altitude, unless its
@@ -325,18 +359,28 @@ impl SkyLutsPass {
         sun_dir: Vec3,
         camera_altitude_m: f32,
     ) -> Result<TableBuilds, GpuError> {
+        ctx.checked(|| self.update_sky_view(&ctx.device, &ctx.queue, sun_dir, camera_altitude_m))
+    }
+
+    /// [`Self::rebuild_sky_view`] on an application's device.
+    pub fn update_sky_view(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        sun_dir: Vec3,
+        camera_altitude_m: f32,
+    ) -> TableBuilds {
         let view = view_inputs(&self.last.params, sun_dir, camera_altitude_m);
         if view == self.last.view {
-            return Ok(TableBuilds::default());
+            return TableBuilds::default();
         }
-        ctx.queue
-            .write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&view));
-        self.encode(ctx, [false, false, true])?;
+        queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&view));
+        self.encode(device, queue, [false, false, true]);
         self.last.view = view;
-        Ok(self.count(TableBuilds {
+        self.count(TableBuilds {
             sky_view: 1,
             ..TableBuilds::default()
-        }))
+        })
     }
 
     fn count(&mut self, built: TableBuilds) -> TableBuilds {
@@ -347,13 +391,11 @@ impl SkyLutsPass {
     /// Records and submits the compute passes of the tables in `which`
     /// (in build order: each reads the ones before it), each labelled with
     /// its table and timed when the device has timestamps. Does not wait.
-    fn encode(&self, ctx: &GpuContext, which: [bool; 3]) -> Result<(), GpuError> {
-        ctx.checked(|| {
-            let mut encoder = ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("sky_luts"),
-                });
+    fn encode(&self, device: &wgpu::Device, queue: &wgpu::Queue, which: [bool; 3]) {
+        {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("sky_luts"),
+            });
             for t in SkyTable::ALL.into_iter().filter(|t| which[t.index()]) {
                 let k = t.index() as u32;
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -379,8 +421,18 @@ impl SkyLutsPass {
             if let Some(ts) = &self.timestamps {
                 encoder.copy_buffer_to_buffer(&ts.resolve, 0, &ts.readback, 0, 3 * RESOLVE_STRIDE);
             }
-            ctx.queue.submit([encoder.finish()]);
-        })
+            queue.submit([encoder.finish()]);
+        }
+    }
+
+    /// The uniform block of the params the tables were built with.
+    pub fn params_buffer(&self) -> &wgpu::Buffer {
+        &self.params_buffer
+    }
+
+    /// The params of the last build.
+    pub fn params(&self) -> &SkyParams {
+        &self.last.params
     }
 
     /// Builds per table since creation (the first build counts one each).

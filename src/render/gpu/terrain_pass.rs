@@ -31,7 +31,7 @@ impl TerrainPass {
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        group0: &wgpu::BindGroupLayout,
+        inputs: &Inputs,
         constants: &[(&str, f64)],
         h: &Heightfield,
         (width, height): (u32, u32),
@@ -51,7 +51,7 @@ impl TerrainPass {
         let n = h.size() as u32;
         let (color, depth) = targets(device, width, height);
         Self {
-            pipeline: pipeline(device, group0, &layout, constants),
+            pipeline: pipeline(device, inputs, &layout, constants),
             layout,
             group1,
             vertices: n * n * 6,
@@ -67,10 +67,10 @@ impl TerrainPass {
     pub fn rebuild_pipeline(
         &mut self,
         device: &wgpu::Device,
-        group0: &wgpu::BindGroupLayout,
+        inputs: &Inputs,
         constants: &[(&str, f64)],
     ) {
-        self.pipeline = pipeline(device, group0, &self.layout, constants);
+        self.pipeline = pipeline(device, inputs, &self.layout, constants);
     }
 
     /// Recreates the colour and depth targets for a new size.
@@ -115,12 +115,13 @@ fn targets(device: &wgpu::Device, width: u32, height: u32) -> (wgpu::Texture, wg
 
 fn pipeline(
     device: &wgpu::Device,
-    group0: &wgpu::BindGroupLayout,
+    inputs: &Inputs,
     group1: &wgpu::BindGroupLayout,
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
-    let module = bind::module(device, "terrain", shaders::terrain_pass());
-    let layout = bind::pipeline_layout(device, "terrain", &[group0, group1]);
+    let source = shaders::terrain_pass(inputs.sky.is_some());
+    let module = bind::module(device, "terrain", source);
+    let layout = bind::pipeline_layout(device, "terrain", &[&inputs.layout, group1]);
     let options = || wgpu::PipelineCompilationOptions {
         constants,
         zero_initialize_workgroup_memory: false,

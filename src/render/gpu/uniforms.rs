@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 use crate::render::camera::View;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::{Quality, SUN_INTENSITY};
-use crate::render::cpu::sky::{sky_radiance, sun_color, sun_direction};
+use crate::render::cpu::sky::{analytic_sky, sun_color, sun_direction};
 use crate::render::cpu::sky_luts::SkyParams;
 #[cfg(doc)]
 use crate::render::cpu::sky_luts::radius_at_altitude;
@@ -68,13 +68,14 @@ pub struct FrameInputs {
 }
 
 impl FrameUniforms {
-    /// Fills the block; the per-frame constants (sun colour, zenith
-    /// ambient) are computed here once instead of per pixel.
+    /// Fills the block; the analytic sky's per-frame constants (sun
+    /// colour, zenith) are computed here once instead of per pixel (the
+    /// physical sky reads its tables).
     pub fn new(i: &FrameInputs) -> Self {
         let (w, h) = (i.width.max(1) as f32, i.height.max(1) as f32);
         let sun_dir = sun_direction(i.sun_elevation_deg, i.sun_azimuth_deg);
         let sun = sun_color(sun_dir) * SUN_INTENSITY;
-        let sky_up = sky_radiance(Vec3::Y, sun_dir);
+        let sky_up = analytic_sky(Vec3::Y, sun_dir);
         let ambient = sky_up * 0.25;
         let q = &i.quality;
         let d = &i.density;
