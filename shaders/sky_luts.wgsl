@@ -21,6 +21,8 @@ const MULTI_SCATTERING_DIRECTIONS: u32 = 64u;
 const MULTI_SCATTERING_STEPS: u32 = 20u;
 const SKY_VIEW_STEPS: u32 = 30u;
 const AERIAL_PERSPECTIVE_STEPS: u32 = 10u;
+const SKY_AMBIENT_ROWS: u32 = 16u;
+const SKY_AMBIENT_COLUMNS: u32 = 32u;
 const LIMB_DARKENING_U: f32 = 0.6;
 
 // Keep in sync with src/render/gpu/uniforms.rs: SkyParamsUniforms (96
@@ -430,6 +432,21 @@ fn sky_view_texel(
         multi_scattering,
     );
     return s.inscatter * p.sun_irradiance;
+}
+
+// ---- Sky ambient ----
+
+fn sky_ambient_texel(sky_view: texture_2d<f32>, r: f32, p: SkyParams) -> vec3f {
+    var sum = vec3f(0.0);
+    for (var i = 0u; i < SKY_AMBIENT_ROWS; i++) {
+        let mu = (f32(i) + 0.5) / f32(SKY_AMBIENT_ROWS);
+        for (var j = 0u; j < SKY_AMBIENT_COLUMNS; j++) {
+            let azimuth = (f32(j) + 0.5) / f32(SKY_AMBIENT_COLUMNS) * PI;
+            let c = sky_view_texel_coords(mu, azimuth, r, p);
+            sum += sample_texels(sky_view, c.fx, c.fy, c.row_min, c.row_max);
+        }
+    }
+    return sum / f32(SKY_AMBIENT_ROWS * SKY_AMBIENT_COLUMNS);
 }
 
 // ---- Lookups (src/render/cpu/sky_luts/lookups.rs) ----

@@ -1,4 +1,4 @@
-// The sky tables' three compute entry points, appended to sky_luts.wgsl
+// The sky tables' four compute entry points, appended to sky_luts.wgsl
 // (src/render/gpu/sky_luts_pass.rs builds them): one invocation per texel.
 
 const PI: f32 = 3.14159265358979;
@@ -8,6 +8,7 @@ const PI: f32 = 3.14159265358979;
 @group(0) @binding(2) var transmittance_lut: texture_2d<f32>;
 @group(0) @binding(3) var multi_scattering_lut: texture_2d<f32>;
 @group(0) @binding(4) var<uniform> sky_view_inputs: SkyView;
+@group(0) @binding(5) var sky_view_lut: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8)
 fn cs_transmittance(@builtin(global_invocation_id) id: vec3u) {
@@ -40,5 +41,15 @@ fn cs_sky_view(@builtin(global_invocation_id) id: vec3u) {
         transmittance_lut,
         multi_scattering_lut,
     );
+    textureStore(lut_out, id.xy, vec4f(c, 1.0));
+}
+
+// One texel: the sky's mean radiance over the upper hemisphere.
+@compute @workgroup_size(8, 8)
+fn cs_sky_ambient(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= 1u || id.y >= 1u {
+        return;
+    }
+    let c = sky_ambient_texel(sky_view_lut, sky_view_inputs.camera_radius_km, params);
     textureStore(lut_out, id.xy, vec4f(c, 1.0));
 }

@@ -1,7 +1,7 @@
 // The physical sky (appended after clouds.wgsl and sky_luts.wgsl when the
 // scene's `[render.atmosphere] model` is "physical"): the twins of the
 // physical arms of src/render/cpu/sky.rs, reading Hillaire 2020's tables
-// that src/render/gpu/sky_luts_pass.rs builds (bindings 7 to 10 of group
+// that src/render/gpu/sky_luts_pass.rs builds (bindings 7 to 11 of group
 // 0 exist only in this variant). The sky view is built for the camera's
 // altitude, frame.cam_pos.y.
 
@@ -9,6 +9,7 @@
 @group(0) @binding(8) var transmittance_lut: texture_2d<f32>;
 @group(0) @binding(9) var multi_scattering_lut: texture_2d<f32>;
 @group(0) @binding(10) var sky_view_lut: texture_2d<f32>;
+@group(0) @binding(11) var sky_ambient_lut: texture_2d<f32>;
 
 fn sun_light_at(altitude_m: f32, sun_dir: vec3f) -> vec3f {
     return sun_radiance_at(transmittance_lut, sky_params, max(altitude_m, 0.0), sun_dir);
@@ -18,19 +19,9 @@ fn sky_above(dir: vec3f, sun_dir: vec3f) -> vec3f {
     return sky_view_radiance(sky_view_lut, frame.cam_pos.y, sky_params, dir, sun_dir);
 }
 
-// The mean of the zenith and four azimuths at 20° and at 55° elevation
-// (the CPU's SKY_AMBIENT_ELEVATIONS).
+// The sky-ambient table's one texel.
 fn sky_ambient(sun_dir: vec3f) -> vec3f {
-    var sum = sky_above(vec3f(0.0, 1.0, 0.0), sun_dir);
-    let elevations = array(vec2f(0.9396926, 0.3420201), vec2f(0.5735764, 0.819152));
-    for (var k = 0u; k < 2u; k++) {
-        let e = elevations[k];
-        for (var i = 0u; i < 4u; i++) {
-            let a = (f32(i) + 0.5 * f32(k)) * 0.5 * PI;
-            sum += sky_above(vec3f(e.x * sin(a), e.y, e.x * cos(a)), sun_dir);
-        }
-    }
-    return sum / 9.0;
+    return textureLoad(sky_ambient_lut, vec2u(0u, 0u), 0).rgb;
 }
 
 fn aerial(dir: vec3f, distance_m: f32, sun_dir: vec3f) -> Aerial {

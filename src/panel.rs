@@ -4,6 +4,7 @@
 //! like any other. (Kept in the library, without egui, so the round trip
 //! is tested.)
 
+use crate::render::cpu::sky::SkyModel;
 use crate::scene::Scene;
 use crate::sim::Band;
 
@@ -37,6 +38,10 @@ pub struct PanelState {
     pub octaves: u32,
     /// The terrain.
     pub terrain: bool,
+    /// The physical sky (off: the analytic one).
+    pub physical_sky: bool,
+    /// The physical sky's aerosol optical depth, 0..=3.
+    pub aerosol_optical_depth: f32,
 }
 
 impl PanelState {
@@ -57,6 +62,8 @@ impl PanelState {
             shadow_steps: r.shadow_steps,
             octaves: r.octaves,
             terrain: r.terrain.enabled,
+            physical_sky: r.atmosphere.model == SkyModel::Physical,
+            aerosol_optical_depth: r.atmosphere.aerosol_optical_depth,
         }
     }
 
@@ -71,6 +78,12 @@ impl PanelState {
         r.shadow_steps = self.shadow_steps;
         r.octaves = self.octaves;
         r.terrain.enabled = self.terrain;
+        r.atmosphere.model = if self.physical_sky {
+            SkyModel::Physical
+        } else {
+            SkyModel::Analytic
+        };
+        r.atmosphere.aerosol_optical_depth = self.aerosol_optical_depth;
         scene.physics.parcels = self.parcels;
         scene.physics.wind.speed_mps = self.wind_speed_mps;
         scene.physics.wind.direction_deg = self.wind_direction_deg;

@@ -36,7 +36,7 @@ fn bench_quick_writes_well_formed_results() {
     let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
     assert_eq!(
         header,
-        "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,frames,p_covered,median_ms,p95_ms,timing"
+        "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,sky,aerial,frames,p_covered,median_ms,p95_ms,timing"
             .split(',')
             .collect::<Vec<_>>()
     );

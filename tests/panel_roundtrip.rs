@@ -23,6 +23,8 @@ fn roundtrip(name: &str) {
     panel.shadow_steps = 3;
     panel.octaves = 1;
     panel.terrain = !panel.terrain;
+    panel.physical_sky = !panel.physical_sky;
+    panel.aerosol_optical_depth = 0.42;
     panel.apply(&mut scene);
 
     // Saved elsewhere: a sounding path must still find its file.

@@ -104,7 +104,7 @@ fn on_horizon(y: u32) -> bool {
 type Check<'a> = (SkyTable, &'a Lut2, fn(u32) -> bool, f32, &'static str);
 
 fn compare(pass: &SkyLutsPass, ctx: &GpuContext, cpu: &SkyLuts, what: &str) {
-    let checks: [Check; 4] = [
+    let checks: [Check; 5] = [
         (
             SkyTable::Transmittance,
             &cpu.transmittance,
@@ -132,6 +132,13 @@ fn compare(pass: &SkyLutsPass, ctx: &GpuContext, cpu: &SkyLuts, what: &str) {
             on_horizon,
             SKY_VIEW_HORIZON_REL,
             ", horizon row",
+        ),
+        (
+            SkyTable::SkyAmbient,
+            &cpu.sky_ambient,
+            all_rows,
+            SKY_VIEW_REL,
+            "",
         ),
     ];
     for (table, cpu_table, rows, bound, which) in checks {
@@ -171,8 +178,8 @@ fn gpu_tables_match_the_cpu_twins() {
     let mut cpu = SkyLuts::build(params, high, altitude_m);
     compare(&pass, &ctx, &cpu, "sun 30°");
     match pass.table_times_ms(&ctx).expect("timestamps") {
-        Some([t, ms, sv]) => eprintln!(
-            "GPU time: transmittance {t:.3} ms, multiple scattering {ms:.3} ms, sky view {sv:.3} ms"
+        Some([t, ms, sv, amb]) => eprintln!(
+            "GPU time: transmittance {t:.3} ms, multiple scattering {ms:.3} ms, sky view {sv:.3} ms, sky ambient {amb:.3} ms"
         ),
         None => eprintln!("GPU time: no timestamp queries on this adapter"),
     }

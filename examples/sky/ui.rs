@@ -135,6 +135,15 @@ pub fn panel(
             0.0..=360.0,
             "sun azimuth, ° from north",
         );
+        ch |= ui
+            .checkbox(&mut p.physical_sky, "physical sky (off: analytic)")
+            .changed();
+        ch |= unit_slider(
+            ui,
+            &mut p.aerosol_optical_depth,
+            0.0..=1.5,
+            "aerosol optical depth (haze)",
+        );
         ui.separator();
         ui.label("Quality (off = the pass or code is not built)");
         ch |= ui

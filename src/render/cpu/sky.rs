@@ -164,33 +164,20 @@ pub fn sky_above(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
     }
 }
 
-/// Directions of [`sky_ambient`]'s mean (inlined in WGSL): the zenith and
-/// four azimuths at 20° and at 55° elevation, as (cos, sin) of the
-/// elevation; the azimuths are 0°, 90°, 180°, 270° from north at 20° and
-/// 45°, 135°, 225°, 315° at 55°.
-pub const SKY_AMBIENT_ELEVATIONS: [(f32, f32); 2] =
-    [(0.939_692_6, 0.342_020_1), (0.573_576_4, 0.819_152)];
-
 /// The sky's light on a surface or into a cloud, as a radiance: what
 /// times π is the irradiance of level ground (the land's and terrain's
 /// sky light) and times 1/4 the cloud's isotropically scattered sky light
 /// at its top. Analytic: the zenith's radiance (its sky is nearly uniform;
-/// the ambient gain was fitted on it). Physical: the mean of nine
-/// directions ([`SKY_AMBIENT_ELEVATIONS`]), for its horizon is several
-/// times brighter than its zenith.
+/// the ambient gain was fitted on it). Physical: the sky's mean radiance
+/// over the upper hemisphere, the sky-ambient table built with the sky
+/// view ([`super::sky_luts::sky_ambient_texel`]), for its horizon is
+/// several times brighter than its zenith.
 #[inline]
 pub fn sky_ambient(sky: &SkyLight, sun_dir: Vec3) -> Vec3 {
-    if sky.luts.is_none() {
-        return sky_above(sky, Vec3::Y, sun_dir);
+    match sky.luts {
+        Some(luts) => luts.sky_ambient.texel(0, 0),
+        None => sky_above(sky, Vec3::Y, sun_dir),
     }
-    let mut sum = sky_above(sky, Vec3::Y, sun_dir);
-    for (k, (c, s)) in SKY_AMBIENT_ELEVATIONS.into_iter().enumerate() {
-        for i in 0..4 {
-            let a = (i as f32 + 0.5 * k as f32) * 0.5 * PI;
-            sum += sky_above(sky, Vec3::new(c * a.sin(), s, c * a.cos()), sun_dir);
-        }
-    }
-    sum / 9.0
 }
 
 /// Sky radiance seen along `dir`, without the sun disk; below the horizon

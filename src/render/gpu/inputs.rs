@@ -2,7 +2,7 @@
 //! P, the cloud map (with mips), the coverage mask of P, the wrapping
 //! sampler, the 3D detail volume (with mips) and the blue-noise tile; under
 //! the physical sky also the atmosphere's params and its three tables
-//! (bindings 7 to 10, built by [`SkyLutsPass`]; absent under the analytic
+//! (bindings 7 to 11, built by [`SkyLutsPass`]; absent under the analytic
 //! sky).
 
 use glam::Vec3;
@@ -247,6 +247,7 @@ fn group0_layout(device: &wgpu::Device, sky: bool) -> wgpu::BindGroupLayout {
             bind::texture_entry(8, UNFILTERABLE),
             bind::texture_entry(9, UNFILTERABLE),
             bind::texture_entry(10, UNFILTERABLE),
+            bind::texture_entry(11, UNFILTERABLE),
         ]);
     }
     bind::layout(device, "clouds.group0", &entries)

@@ -24,7 +24,7 @@ pub const SKY_ANALYTIC: &str = include_str!("../../../shaders/sky_analytic.wgsl"
 pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl");
 
 /// The shared functions with the sky model's: the physical atmosphere's
-/// tables (bindings 7 to 10 of group 0) when `physical`, else the
+/// tables (bindings 7 to 11 of group 0) when `physical`, else the
 /// analytic sky.
 pub fn shared(physical: bool) -> String {
     if physical {

@@ -5,7 +5,7 @@
 //! change, the sky view only when they or its inputs (the sun's elevation,
 //! the camera's altitude) do: the pass keeps the last inputs and skips a
 //! build whose inputs are equal. The renderer's passes read the tables
-//! under the physical sky (`shaders/sky_physical.wgsl`, bindings 7 to 10
+//! under the physical sky (`shaders/sky_physical.wgsl`, bindings 7 to 11
 //! of group 0, [`super::inputs`]).
 
 use glam::Vec3;
@@ -16,7 +16,8 @@ use super::shaders::sky_luts_pass;
 use super::textures::create_2d;
 use super::uniforms::{SkyParamsUniforms, SkyViewUniforms};
 use crate::render::cpu::sky_luts::{
-    Lut2, MULTI_SCATTERING_SIZE, SKY_VIEW_SIZE, SkyParams, TRANSMITTANCE_SIZE, radius_at_altitude,
+    Lut2, MULTI_SCATTERING_SIZE, SKY_AMBIENT_SIZE, SKY_VIEW_SIZE, SkyParams, TRANSMITTANCE_SIZE,
+    radius_at_altitude,
 };
 
 /// Format of the three tables (RGB, alpha 1).
@@ -33,14 +34,17 @@ pub enum SkyTable {
     Transmittance,
     MultiScattering,
     SkyView,
+    SkyAmbient,
 }
 
 impl SkyTable {
-    /// The three, in build order.
-    pub const ALL: [SkyTable; 3] = [
+    /// The four, in build order (the sky ambient is the sky view's mean,
+    /// built with it).
+    pub const ALL: [SkyTable; 4] = [
         SkyTable::Transmittance,
         SkyTable::MultiScattering,
         SkyTable::SkyView,
+        SkyTable::SkyAmbient,
     ];
 
     /// Its label (texture, pipeline, bind group, compute pass).
@@ -49,6 +53,7 @@ impl SkyTable {
             SkyTable::Transmittance => "sky_luts.transmittance",
             SkyTable::MultiScattering => "sky_luts.multi_scattering",
             SkyTable::SkyView => "sky_luts.sky_view",
+            SkyTable::SkyAmbient => "sky_luts.sky_ambient",
         }
     }
 
@@ -58,6 +63,7 @@ impl SkyTable {
             SkyTable::Transmittance => TRANSMITTANCE_SIZE,
             SkyTable::MultiScattering => MULTI_SCATTERING_SIZE,
             SkyTable::SkyView => SKY_VIEW_SIZE,
+            SkyTable::SkyAmbient => SKY_AMBIENT_SIZE,
         }
     }
 
@@ -66,6 +72,7 @@ impl SkyTable {
             SkyTable::Transmittance => "cs_transmittance",
             SkyTable::MultiScattering => "cs_multi_scattering",
             SkyTable::SkyView => "cs_sky_view",
+            SkyTable::SkyAmbient => "cs_sky_ambient",
         }
     }
 
@@ -109,9 +116,9 @@ struct Timestamps {
 
 /// The three tables, their compute pipelines and bind groups.
 pub struct SkyLutsPass {
-    textures: [wgpu::Texture; 3],
-    pipelines: [wgpu::ComputePipeline; 3],
-    groups: [wgpu::BindGroup; 3],
+    textures: [wgpu::Texture; 4],
+    pipelines: [wgpu::ComputePipeline; 4],
+    groups: [wgpu::BindGroup; 4],
     params_buffer: wgpu::Buffer,
     view_buffer: wgpu::Buffer,
     timestamps: Option<Timestamps>,
@@ -142,7 +149,7 @@ fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
 /// Bindings 0..n of `shaders/sky_luts.wgsl`: params, the table written,
 /// the transmittance table, the multiple-scattering table, the sky view's
 /// inputs. Each pass binds a prefix.
-fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
+fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
     let table = |binding| {
         compute_entry(
             binding,
@@ -166,6 +173,7 @@ fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
         table(2),
         table(3),
         uniform(4),
+        table(5),
     ]
 }
 
@@ -238,7 +246,7 @@ impl SkyLutsPass {
         let entries = layout_entries();
         let views = textures.each_ref().map(bind::view);
         let pipelines_and_groups = SkyTable::ALL.map(|t| {
-            let bindings = [2, 3, 5][t.index()];
+            let bindings = [2, 3, 5, 6][t.index()];
             let layout = bind::layout(device, t.label(), &entries[..bindings]);
             let pipeline_layout = bind::pipeline_layout(device, t.label(), &[&layout]);
             let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -255,34 +263,35 @@ impl SkyLutsPass {
                 wgpu::BindingResource::TextureView(&views[0]),
                 wgpu::BindingResource::TextureView(&views[1]),
                 view_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&views[2]),
             ];
             let group = bind::bind(device, t.label(), &layout, &resources[..bindings]);
             (pipeline, group)
         });
-        let [(p0, g0), (p1, g1), (p2, g2)] = pipelines_and_groups;
+        let [(p0, g0), (p1, g1), (p2, g2), (p3, g3)] = pipelines_and_groups;
         let timestamps = timestamps.then(|| Timestamps {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("sky_luts.timestamps"),
                 ty: wgpu::QueryType::Timestamp,
-                count: 6,
+                count: 8,
             }),
             resolve: buffer(
                 device,
                 "sky_luts.timestamps.resolve",
-                3 * RESOLVE_STRIDE,
+                4 * RESOLVE_STRIDE,
                 wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             ),
             readback: buffer(
                 device,
                 "sky_luts.timestamps.readback",
-                3 * RESOLVE_STRIDE,
+                4 * RESOLVE_STRIDE,
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             ),
         });
         Self {
             textures,
-            pipelines: [p0, p1, p2],
-            groups: [g0, g1, g2],
+            pipelines: [p0, p1, p2, p3],
+            groups: [g0, g1, g2, g3],
             params_buffer,
             view_buffer,
             timestamps,
@@ -338,7 +347,7 @@ impl SkyLutsPass {
         let block = SkyParamsUniforms::new(params);
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&block));
         queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&view));
-        self.encode(device, queue, [true; 3]);
+        self.encode(device, queue, [true; 4]);
         self.last = Inputs {
             params: *params,
             view,
@@ -375,7 +384,7 @@ impl SkyLutsPass {
             return TableBuilds::default();
         }
         queue.write_buffer(&self.view_buffer, 0, bytemuck::bytes_of(&view));
-        self.encode(device, queue, [false, false, true]);
+        self.encode(device, queue, [false, false, true, true]);
         self.last.view = view;
         self.count(TableBuilds {
             sky_view: 1,
@@ -391,7 +400,7 @@ impl SkyLutsPass {
     /// Records and submits the compute passes of the tables in `which`
     /// (in build order: each reads the ones before it), each labelled with
     /// its table and timed when the device has timestamps. Does not wait.
-    fn encode(&self, device: &wgpu::Device, queue: &wgpu::Queue, which: [bool; 3]) {
+    fn encode(&self, device: &wgpu::Device, queue: &wgpu::Queue, which: [bool; 4]) {
         {
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("sky_luts"),
@@ -419,7 +428,7 @@ impl SkyLutsPass {
                 }
             }
             if let Some(ts) = &self.timestamps {
-                encoder.copy_buffer_to_buffer(&ts.resolve, 0, &ts.readback, 0, 3 * RESOLVE_STRIDE);
+                encoder.copy_buffer_to_buffer(&ts.resolve, 0, &ts.readback, 0, 4 * RESOLVE_STRIDE);
             }
             queue.submit([encoder.finish()]);
         }
@@ -459,7 +468,7 @@ impl SkyLutsPass {
     /// The GPU time (ms) of each table's latest build, in [`SkyTable::ALL`]
     /// order (0 for a table never timed); `None` without timestamp queries.
     /// Waits for the GPU.
-    pub fn table_times_ms(&self, ctx: &GpuContext) -> Result<Option<[f64; 3]>, GpuError> {
+    pub fn table_times_ms(&self, ctx: &GpuContext) -> Result<Option<[f64; 4]>, GpuError> {
         let Some(ts) = &self.timestamps else {
             return Ok(None);
         };

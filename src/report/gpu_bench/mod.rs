@@ -17,6 +17,7 @@ pub use write::write;
 
 use super::ReportError;
 use crate::prepare::Prepared;
+use crate::render::cpu::sky::SkyModel;
 use crate::render::gpu::{GpuContext, GpuError};
 use crate::scene::{RenderSettings, Scene, SceneError};
 use physics_share::physics_in_frame;
@@ -53,6 +54,17 @@ pub struct BenchOptions {
 pub const COVERAGES: [f32; 4] = [0.91, 0.71, 0.51, 0.10];
 /// Parcel counts (12: the paper; 85: Goswami & Neyret 2017).
 pub const PARCELS: [usize; 4] = [12, 85, 1_000, 10_000];
+/// The feature rows, in order: the defaults, then one change each.
+pub const FEATURES: [&str; 8] = [
+    "defaults",
+    "tsaa off",
+    "terrain on",
+    "shadows off",
+    "octaves 0",
+    "detail off",
+    "analytic sky",
+    "aerial off",
+];
 /// Resolutions of the full run.
 pub const RESOLUTIONS: [(u32, u32); 3] = [(640, 480), (1280, 720), (1920, 1080)];
 
@@ -70,6 +82,10 @@ pub struct Row {
     pub shadow_steps: u32,
     pub octaves: u32,
     pub detail: bool,
+    /// The sky model: "physical" or "analytic".
+    pub sky: &'static str,
+    /// Aerial perspective on.
+    pub aerial: bool,
     pub frames: u32,
     /// Fraction of P's texels with coverage.
     pub p_covered: f64,
@@ -217,15 +233,17 @@ pub fn run(
         let t = time_cloud_map(ctx, &p, &r, o)?;
         rows.push(row("coverage", "cloud_map", &r, &p, Some(&t), o.frames));
     }
-    let variants: [(&str, Tweak); 6] = [
-        ("defaults", |_| {}),
-        ("tsaa off", |r| r.tsaa = false),
-        ("terrain on", |r| r.terrain.enabled = true),
-        ("shadows off", |r| r.shadow_steps = 0),
-        ("octaves 0", |r| r.octaves = 0),
-        ("detail off", |r| r.detail_strength = 0.0),
+    let tweaks: [Tweak; 8] = [
+        |_| {},
+        |r| r.tsaa = false,
+        |r| r.terrain.enabled = true,
+        |r| r.shadow_steps = 0,
+        |r| r.octaves = 0,
+        |r| r.detail_strength = 0.0,
+        |r| r.atmosphere.model = SkyModel::Analytic,
+        |r| r.atmosphere.aerial_perspective = false,
     ];
-    for (name, f) in variants {
+    for (name, f) in FEATURES.into_iter().zip(tweaks) {
         let mut s2 = sc.clone();
         f(&mut s2.render);
         progress(&format!("features: {name}"));

@@ -3,6 +3,7 @@
 
 use super::{BenchOptions, Row};
 use crate::prepare::Prepared;
+use crate::render::cpu::sky::SkyModel;
 use crate::render::gpu::baseline::BaselineRenderer;
 use crate::render::gpu::headless::TARGET_FORMAT;
 use crate::render::gpu::timer::{FrameTimes, time_frames};
@@ -15,6 +16,8 @@ struct Features {
     shadow_steps: u32,
     octaves: u32,
     detail: bool,
+    sky: &'static str,
+    aerial: bool,
 }
 
 fn features_of(r: &RenderSettings) -> Features {
@@ -24,6 +27,11 @@ fn features_of(r: &RenderSettings) -> Features {
         shadow_steps: r.shadow_steps,
         octaves: r.octaves,
         detail: r.detail_strength > 0.0,
+        sky: match r.atmosphere.model {
+            SkyModel::Physical => "physical",
+            SkyModel::Analytic => "analytic",
+        },
+        aerial: r.atmosphere.aerial_perspective,
     }
 }
 
@@ -86,6 +94,8 @@ pub(super) fn row(
         shadow_steps: f.shadow_steps,
         octaves: f.octaves,
         detail: f.detail,
+        sky: f.sky,
+        aerial: f.aerial,
         frames: if t.is_some() { frames } else { 0 },
         p_covered: p.field.covered_fraction(),
         median_ms: t.map_or(f64::NAN, FrameTimes::median),

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::{Report, Row};
+use super::{FEATURES, Report, Row};
 use crate::io::write_atomically;
 use crate::report::ReportError;
 use crate::report::plot::{Series, bars_png, loglog_png};
@@ -12,12 +12,12 @@ use crate::report::plot::{Series, bars_png, loglog_png};
 pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     let path = dir.join("bench.csv");
     write_atomically(&path, |out| {
-        writeln!(out, "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,frames,p_covered,median_ms,p95_ms,timing")?;
+        writeln!(out, "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,sky,aerial,frames,p_covered,median_ms,p95_ms,timing")?;
         for r in &report.rows {
             writeln!(
                 out,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{}",
-                r.group, r.renderer, r.width, r.height, r.coverage, r.parcels, r.tsaa, r.terrain, r.shadow_steps, r.octaves, r.detail, r.frames, r.p_covered, r.median_ms, r.p95_ms, r.timing
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{}",
+                r.group, r.renderer, r.width, r.height, r.coverage, r.parcels, r.tsaa, r.terrain, r.shadow_steps, r.octaves, r.detail, r.sky, r.aerial, r.frames, r.p_covered, r.median_ms, r.p95_ms, r.timing
             )?;
         }
         Ok(())
@@ -96,18 +96,7 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         .enumerate()
         .map(|(k, r)| {
             (
-                [
-                    "defaults",
-                    "tsaa off",
-                    "terrain on",
-                    "shadows off",
-                    "octaves 0",
-                    "detail off",
-                ]
-                .get(k)
-                .copied()
-                .unwrap_or("?")
-                .to_owned(),
+                FEATURES.get(k).copied().unwrap_or("?").to_owned(),
                 r.median_ms,
             )
         })

@@ -296,6 +296,34 @@ pub fn sky_view_texel(
     inscatter * p.sun_irradiance
 }
 
+/// The sky-ambient quadrature: rows of cos zenith, uniform in (0, 1)
+/// (uniform in solid angle over the upper hemisphere), and columns of
+/// azimuth from the sun, uniform in (0, π) (the sky is mirror-symmetric
+/// about the sun's vertical).
+pub const SKY_AMBIENT_SAMPLES: (u32, u32) = (16, 32);
+/// The sky-ambient table's size: one texel.
+pub const SKY_AMBIENT_SIZE: (u32, u32) = (1, 1);
+
+/// The sky-ambient texel: the sky's mean radiance over the upper
+/// hemisphere seen from radius `r`, read from the sky-view table on the
+/// [`SKY_AMBIENT_SAMPLES`] grid (cell centres). What lights a cloud or
+/// the ground from the whole sky, including the bright aureole around the
+/// sun at its true (small) solid angle, which a handful of fixed
+/// directions would over- or under-weight.
+pub fn sky_ambient_texel(sky_view: &Lut2, r: f32, p: &SkyParams) -> Vec3 {
+    let (rows, columns) = SKY_AMBIENT_SAMPLES;
+    let mut sum = Vec3::ZERO;
+    for i in 0..rows {
+        let mu = (i as f32 + 0.5) / rows as f32;
+        for j in 0..columns {
+            let azimuth = (j as f32 + 0.5) / columns as f32 * PI;
+            let (fx, fy, lo, hi) = sky_view_texel_coords(mu, azimuth, r, p);
+            sum += sky_view.sample_texels(fx, fy, lo, hi);
+        }
+    }
+    sum / (rows * columns) as f32
+}
+
 /// A 2D table of RGB texels, row-major, ready to upload as `Rgba32Float`
 /// (alpha 1, unused).
 #[derive(Debug, Clone, PartialEq)]
@@ -382,6 +410,13 @@ pub fn build_sky_view(
     })
 }
 
+/// The sky-ambient table (one texel) of a sky view built for a camera at
+/// `camera_altitude_m`.
+pub fn build_sky_ambient(p: &SkyParams, sky_view: &Lut2, camera_altitude_m: f32) -> Lut2 {
+    let r = radius_at_altitude(camera_altitude_m, p);
+    Lut2::from_fn(1, 1, |_, _| sky_ambient_texel(sky_view, r, p))
+}
+
 /// The three tables: transmittance and multiple scattering depend on
 /// `params` only, the sky view also on the sun and the camera's altitude.
 #[derive(Debug, Clone, PartialEq)]
@@ -390,6 +425,9 @@ pub struct SkyLuts {
     pub transmittance: Lut2,
     pub multi_scattering: Lut2,
     pub sky_view: Lut2,
+    /// The sky's mean radiance over the upper hemisphere (1x1,
+    /// [`sky_ambient_texel`]), built with the sky view.
+    pub sky_ambient: Lut2,
     /// Camera altitude above the ground, m.
     pub camera_altitude_m: f32,
     /// Unit vector toward the sun, world frame.
@@ -409,6 +447,7 @@ impl SkyLuts {
             camera_altitude_m,
         );
         Self {
+            sky_ambient: build_sky_ambient(&params, &sky_view, camera_altitude_m),
             params,
             transmittance,
             multi_scattering,
@@ -422,6 +461,7 @@ impl SkyLuts {
     pub fn rebuild_sky_view(&mut self, sun_dir: Vec3, camera_altitude_m: f32) {
         let (t, ms) = (&self.transmittance, &self.multi_scattering);
         self.sky_view = build_sky_view(&self.params, t, ms, sun_dir, camera_altitude_m);
+        self.sky_ambient = build_sky_ambient(&self.params, &self.sky_view, camera_altitude_m);
         (self.sun_dir, self.camera_altitude_m) = (sun_dir, camera_altitude_m);
     }
 }

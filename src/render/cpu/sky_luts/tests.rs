@@ -37,6 +37,7 @@ fn luts(elevation_deg: f32, camera_altitude_m: f32) -> SkyLuts {
     let sky_view = build_sky_view(&p, t, ms, sun_dir, camera_altitude_m);
     let (transmittance, multi_scattering) = (t.clone(), ms.clone());
     SkyLuts {
+        sky_ambient: build_sky_ambient(&p, &sky_view, camera_altitude_m),
         params: p,
         transmittance,
         multi_scattering,
