@@ -14,6 +14,7 @@ use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::gpu::baseline::BaselineRenderer;
 use cumulus::render::gpu::headless::TARGET_FORMAT;
 use cumulus::render::gpu::{Headless, textures};
+use cumulus::report::gpu_bench::FEATURES;
 use cumulus::scene::Scene;
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
@@ -43,11 +44,15 @@ fn bench_quick_writes_well_formed_results() {
     let col = |n: &str| header.iter().position(|h| h == n).unwrap();
     let mut groups = std::collections::BTreeSet::new();
     let (mut timed, mut total) = (0, 0);
+    let mut skies = std::collections::BTreeSet::new();
     for rec in r.records() {
         total += 1;
         let rec = rec.unwrap();
         groups.insert(rec[col("group")].to_owned());
         assert_eq!(rec.len(), header.len());
+        if &rec[col("group")] == "features" {
+            skies.insert((rec[col("sky")].to_owned(), rec[col("aerial")].to_owned()));
+        }
         if &rec[col("timing")] == "skipped" {
             assert_eq!(
                 &rec[col("renderer")],
@@ -70,9 +75,21 @@ fn bench_quick_writes_well_formed_results() {
     }
     assert_eq!(
         total,
-        2 + 4 + 6 + 2 * 4,
+        2 + 4 + FEATURES.len() + 2 * 4,
         "resolutions, coverages, features, parcels x 2"
     );
+    // The sky's cost: the default physical sky, the analytic one, and
+    // aerial perspective off.
+    for pair in [
+        ("physical", "true"),
+        ("analytic", "true"),
+        ("physical", "false"),
+    ] {
+        assert!(
+            skies.contains(&(pair.0.to_owned(), pair.1.to_owned())),
+            "{skies:?}"
+        );
+    }
     assert!(timed >= 16, "{timed} timed rows");
     for g in ["resolution", "coverage", "parcels", "features"] {
         assert!(groups.contains(g), "no {g} rows");

@@ -10,6 +10,7 @@ use cumulus::prepare::Prepared;
 use cumulus::render::cpu::renderer::{render_converged, render_linear, to_srgb8};
 use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::gpu::renderer::{PASS_CLOUDS, PASS_COMPOSITE, PASS_TERRAIN, PASS_TSAA};
+use cumulus::render::gpu::sky_luts_pass::SkyTable;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuError, Headless, RenderError};
 use cumulus::scene::{RenderSettings, Scene};
 
@@ -270,7 +271,7 @@ fn each_scene_builds_only_the_passes_it_needs() {
         let t = hl.renderer.textures();
         t.iter().filter(|n| n.starts_with("sky_luts.")).count()
     };
-    assert_eq!(tables(&hl), 3);
+    assert_eq!(tables(&hl), SkyTable::ALL.len());
     let before = hl.renderer.sky_table_builds().expect("physical");
     hl.render(&ctx, &r.camera(), 2).expect("frames");
     assert_eq!(hl.renderer.sky_table_builds(), Some(before));
@@ -290,7 +291,7 @@ fn each_scene_builds_only_the_passes_it_needs() {
     s.quality.atmosphere.model = SkyModel::Physical;
     hl.renderer.set_settings(&s);
     hl.render(&ctx, &r.camera(), 1).expect("frame");
-    assert_eq!(tables(&hl), 3);
+    assert_eq!(tables(&hl), SkyTable::ALL.len());
 }
 
 /// A low sun lights clouds warm: under the physical sky the sunlit cloud
