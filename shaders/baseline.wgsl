@@ -158,7 +158,8 @@ fn march_spheres(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
 fn fs_baseline(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let px = vec2u(pos.xy);
     let c = march_spheres(frame.cam_pos.xyz, camera_ray(pos.xy), sphere_dither(px.x, px.y));
-    // No cloud shadows on its ground: its bind group has no P or map.
-    let bg = background_radiance(camera_ray(pos.xy), frame.sun_dir.xyz, 1.0);
+    // No cloud shadows on its ground and no clouds in its sea: its bind
+    // group has no P or map.
+    let bg = background_radiance(camera_ray(pos.xy), frame.sun_dir.xyz, 1.0, vec4f(0.0, 0.0, 0.0, 1.0));
     return vec4f(display(c.rgb + (1.0 - c.a) * bg), 1.0);
 }

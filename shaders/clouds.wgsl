@@ -55,6 +55,9 @@ const MULTIPLE_SUN_POWER: f32 = 0.4;
 const AMBIENT_GAIN: f32 = 1.4;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
+// Uniform steps of a ray the sea reflects, and its shadow samples.
+const REFLECTION_STEPS: u32 = 16u;
+const REFLECTION_SHADOW_STEPS: u32 = 4u;
 // The clip depth at which rays are unprojected.
 const RAY_DEPTH: f32 = 0.5;
 
@@ -457,10 +460,11 @@ fn water_light(sun: vec3f, sun_dir: vec3f) -> vec3f {
 // The wind-roughened sea along `dir` (pointing down): the reflected sky,
 // the sun's glint (Cox-Munk slopes, Beckmann), the water's own blue, the
 // air in front (the CPU's `sea_radiance`).
-fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
+fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> vec3f {
     let mu = max(-dir.y, 1e-3);
     let f = fresnel_water(mu);
-    let reflected = sky_above(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+    let mirrored_sky = sky_above(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+    let reflected = reflection.rgb + mirrored_sky * reflection.a;
     let sun = sun_light_at(0.0, sun_dir) * shadow;
     let variance = 0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0);
     let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
@@ -475,6 +479,52 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
     return ground_haze(surface, dir, sun_dir);
 }
 
+// The clouds the sea mirrors (rgb, premultiplied) and the reflected ray's
+// transmittance (a) where a ray that meets no terrain reaches it (the
+// CPU's `sea_reflection`).
+fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec4f {
+    if !SEA || dir.y >= 0.0 || origin.y <= 0.0 {
+        return vec4f(0.0, 0.0, 0.0, 1.0);
+    }
+    let t_sea = origin.y / -dir.y;
+    if t_sea > frame.sun_light.w {
+        return vec4f(0.0, 0.0, 0.0, 1.0);
+    }
+    let p = vec3f(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
+    let r = vec3f(dir.x, -dir.y, dir.z);
+    let seg = band_segment(p, r, frame.band.x, frame.band.y, frame.sun_light.w);
+    if seg.y <= seg.x {
+        return vec4f(0.0, 0.0, 0.0, 1.0);
+    }
+    let spread = frame.cam_pos.w;
+    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
+    let sky_top = sky_ambient(sun_dir) * 0.25;
+    let ground = ground_up(sun_dir, true) * 0.25;
+    let cos_theta = dot(r, sun_dir);
+    let blur = 2.0 * sqrt(0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0));
+    let h = (seg.y - seg.x) / f32(REFLECTION_STEPS);
+    var transmittance = 1.0;
+    var light = vec3f(0.0);
+    for (var i = 0u; i < REFLECTION_STEPS; i++) {
+        let t = seg.x + (f32(i) + dither) * h;
+        let x = p + r * t;
+        let sigma_t = density_at(x, true, (spread + blur) * (t_sea + t));
+        if sigma_t <= 0.0 {
+            continue;
+        }
+        let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS);
+        let tau_sun = -log(max(shadow, 1e-30));
+        let eta = clamp((x.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
+        let scatter = sun * sun_scattering(tau_sun, cos_theta, sun_dir.y) + ambient_light(sky_top, ground, eta);
+        light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
+        transmittance *= exp(-sigma_t * h);
+        if transmittance < MIN_TRANSMITTANCE {
+            break;
+        }
+    }
+    return vec4f(light, transmittance);
+}
+
 // The light rising from the flat ground, unshadowed (the CPU's
 // `ground_up`).
 fn ground_up(sun_dir: vec3f, sea: bool) -> vec3f {
@@ -487,12 +537,12 @@ fn ground_up(sun_dir: vec3f, sea: bool) -> vec3f {
 
 // The sky and the sun disk, or below the horizon the land or the sea in
 // the clouds' shadow (the CPU's `background_radiance`).
-fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
+fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> vec3f {
     if dir.y >= 0.0 {
         return sky_above(dir, sun_dir) + sun_disk(dir, sun_dir);
     }
     if SEA {
-        return sea_radiance(dir, sun_dir, shadow);
+        return sea_radiance(dir, sun_dir, shadow, reflection);
     }
     return land_radiance(dir, sun_dir, shadow);
 }

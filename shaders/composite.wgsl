@@ -39,5 +39,9 @@ fn display(c: vec3f) -> vec3f {
 fn sky_background(pos: vec2f) -> vec3f {
     let dir = camera_ray(pos);
     let sun_dir = frame.sun_dir.xyz;
-    return background_radiance(dir, sun_dir, flat_ground_shadow(frame.cam_pos.xyz, dir, sun_dir));
+    let eye = frame.cam_pos.xyz;
+    // The cloud pass's dither for this pixel and frame.
+    let dither = fract(pixel_dither(u32(pos.x), u32(pos.y)) + frame.jitter.z);
+    let reflection = sea_reflection(eye, dir, dither, sun_dir);
+    return background_radiance(dir, sun_dir, flat_ground_shadow(eye, dir, sun_dir), reflection);
 }

@@ -9,7 +9,9 @@ mod common;
 use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::View;
-use cumulus::render::cpu::renderer::{flat_ground_shadow, render_clouds_linear, to_srgb8};
+use cumulus::render::cpu::renderer::{
+    flat_ground_shadow, pixel_dither, render_clouds_linear, sea_reflection, to_srgb8,
+};
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};
 use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, textures};
@@ -303,7 +305,17 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
             let (x, y) = ((k as u32 % W) as f32 + 0.5, (k as u32 / W) as f32 + 0.5);
             let dir = view.camera_ray(x, y, W, H);
             let shadow = flat_ground_shadow(view.eye(), dir, sun, &frame);
-            let sky = background_radiance(&frame.sky_light(), dir, sun, q.sea_wind_mps, shadow);
+            let spread = view.pixel_spread(W, H);
+            let dither = pixel_dither(x as u32, y as u32);
+            let reflection = sea_reflection(view.eye(), dir, dither, sun, spread, &frame);
+            let sky = background_radiance(
+                &frame.sky_light(),
+                dir,
+                sun,
+                q.sea_wind_mps,
+                shadow,
+                reflection,
+            );
             Vec3::new(px[0], px[1], px[2]) + (1.0 - px[3]) * sky
         })
         .collect();

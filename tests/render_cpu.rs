@@ -6,8 +6,10 @@ use cumulus::render::cpu::density::{
     BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
 };
 use cumulus::render::cpu::lighting::sun_transmittance;
-use cumulus::render::cpu::renderer::{Frame, Quality, march_ray, render_linear, to_srgb8};
-use cumulus::render::cpu::sky::{AtmosphereConfig, SkyModel};
+use cumulus::render::cpu::renderer::{
+    Frame, Quality, flat_ground_shadow, march_ray, render_linear, sea_reflection, to_srgb8,
+};
+use cumulus::render::cpu::sky::{AtmosphereConfig, SkyModel, background_radiance, sun_direction};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
 
@@ -376,4 +378,65 @@ fn averaged_offsets_approach_the_many_step_image() {
     let (e1, e4) = (err(&one), err(&four));
     eprintln!("24 steps: one offset {e1:.5}, four offsets {e4:.5} from 384 steps");
     assert!(e4 < 0.67 * e1, "one offset {e1}, four {e4}");
+}
+
+/// The sea mirrors the clouds above it: under a cloud layer its reflected
+/// ray is dimmed and carries the clouds' light, and the sea pixel's
+/// radiance changes with it; over land, looking up, or with no clouds
+/// there is nothing to mirror.
+#[test]
+fn the_sea_mirrors_the_clouds_above_it() {
+    let cm = cloud_map();
+    let cloudy = ProjectedField::uniform(32, 32, [1.0, 0.8, 1.0]);
+    let clear = ProjectedField::new(32, 32);
+    let sea = |p| {
+        let mut fr = small_frame(p, &cm);
+        fr.quality.sea_wind_mps = Some(7.0);
+        fr
+    };
+    let origin = Vec3::new(0.0, 100.0, 0.0);
+    let sun = sun_direction(40.0, 135.0);
+    // Reflected rays through the band, down at 20° to 60°, all around.
+    let mut dimmed = 0;
+    let mut changed = 0;
+    let n = 36;
+    for k in 0..n {
+        let a = k as f32 * 10f32.to_radians();
+        let e = (20.0 + 40.0 * (k % 4) as f32 / 3.0).to_radians();
+        let dir = Vec3::new(e.cos() * a.sin(), -e.sin(), e.cos() * a.cos());
+        let (light, t) = sea_reflection(origin, dir, 0.5, sun, 1e-3, &sea(&cloudy));
+        assert!((0.0..=1.0).contains(&t) && light.is_finite());
+        if t < 0.5 {
+            assert!(light.max_element() > 0.0, "a cloud mirrored without light");
+            dimmed += 1;
+        }
+        // The pixel (the view ray stays under the band) is the sea with
+        // this reflection, and the reflection changes it.
+        let fr = sea(&cloudy);
+        let sky = fr.sky_light();
+        let shadow = flat_ground_shadow(origin, dir, sun, &fr);
+        let pixel = march_ray(origin, dir, 0.5, 1e-3, &fr).radiance;
+        let mirrored = background_radiance(&sky, dir, sun, Some(7.0), shadow, (light, t));
+        let bare = background_radiance(&sky, dir, sun, Some(7.0), shadow, (Vec3::ZERO, 1.0));
+        assert!((pixel - mirrored).abs().max_element() <= 1e-6 * mirrored.max_element().max(1.0));
+        changed += ((mirrored - bare).abs().max_element() > 1e-3 * bare.max_element()) as u32;
+        // No clouds, land, or a ray that looks up: nothing mirrored.
+        let none = (Vec3::ZERO, 1.0);
+        assert_eq!(
+            sea_reflection(origin, dir, 0.5, sun, 1e-3, &sea(&clear)).1,
+            1.0
+        );
+        let land = small_frame(&cloudy, &cm);
+        assert_eq!(sea_reflection(origin, dir, 0.5, sun, 1e-3, &land), none);
+        let up = Vec3::new(dir.x, -dir.y, dir.z);
+        assert_eq!(
+            sea_reflection(origin, up, 0.5, sun, 1e-3, &sea(&cloudy)),
+            none
+        );
+    }
+    assert!(dimmed > n / 4, "{dimmed} of {n} reflections meet cloud");
+    assert!(
+        changed >= dimmed,
+        "{changed} sea pixels changed by their reflection"
+    );
 }

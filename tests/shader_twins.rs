@@ -114,6 +114,11 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             sky_luts::AERIAL_PERSPECTIVE_STEPS as f64,
         ),
         ("LIMB_DARKENING_U", sky_luts::LIMB_DARKENING_U as f64),
+        ("REFLECTION_STEPS", renderer::REFLECTION_STEPS as f64),
+        (
+            "REFLECTION_SHADOW_STEPS",
+            renderer::REFLECTION_SHADOW_STEPS as f64,
+        ),
         ("SKY_AMBIENT_ROWS", sky_luts::SKY_AMBIENT_SAMPLES.0 as f64),
         (
             "SKY_AMBIENT_COLUMNS",

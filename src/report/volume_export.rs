@@ -288,7 +288,7 @@ pub fn sky_envmap(frame: &Frame, width: u32, height: u32) -> Vec<f32> {
         .flat_map(|(i, j)| {
             let d = envmap_direction(i, j, width, height);
             match frame.quality.sea_wind_mps {
-                Some(wind) if d.y < 0.0 => sea_radiance(sky, d, sun, wind, 1.0),
+                Some(wind) if d.y < 0.0 => sea_radiance(sky, d, sun, wind, 1.0, (Vec3::ZERO, 1.0)),
                 _ => sky_radiance(sky, d, sun),
             }
             .to_array()

@@ -359,16 +359,27 @@ fn water_light(sky: &SkyLight, sun: Vec3, sun_dir: Vec3) -> Vec3 {
 ///
 /// then seen through the air as the land is ([`ground_haze`]). The
 /// clouds' `shadow` (transmittance toward the sun) dims the glint and the
-/// sunlit part of the water; clouds are not reflected.
+/// sunlit part of the water. `reflection` is the clouds the mean surface
+/// mirrors (their premultiplied light and transmittance,
+/// `renderer::sea_reflection`; `(0, 1)`: none), in front of the mirrored
+/// sky.
 #[inline]
-pub fn sea_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, wind_mps: f32, shadow: f32) -> Vec3 {
+pub fn sea_radiance(
+    sky: &SkyLight,
+    dir: Vec3,
+    sun_dir: Vec3,
+    wind_mps: f32,
+    shadow: f32,
+    reflection: (Vec3, f32),
+) -> Vec3 {
     let mu = (-dir.y).max(1e-3);
     let f = fresnel_water(mu);
-    let reflected = sky_above(
+    let mirrored_sky = sky_above(
         sky,
         Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y),
         sun_dir,
     );
+    let reflected = reflection.0 + mirrored_sky * reflection.1;
     let sun = sun_light_at(sky, 0.0, sun_dir) * shadow;
     let variance = 0.003 + 0.00512 * wind_mps.max(0.0);
     let h = (sun_dir - dir).normalize_or(Vec3::Y);
@@ -400,8 +411,8 @@ pub fn ground_up(sky: &SkyLight, sun_dir: Vec3, sea: bool) -> Vec3 {
 
 /// What a ray that meets no terrain sees along `dir`: the sky and the sun
 /// disk, or below the horizon the land ([`land_radiance`]) or, with
-/// `sea_wind_mps`, the sea ([`sea_radiance`]), in the clouds' `shadow`
-/// where the ray meets them.
+/// `sea_wind_mps`, the sea ([`sea_radiance`], mirroring the clouds of
+/// `reflection`), in the clouds' `shadow` where the ray meets them.
 #[inline]
 pub fn background_radiance(
     sky: &SkyLight,
@@ -409,12 +420,13 @@ pub fn background_radiance(
     sun_dir: Vec3,
     sea_wind_mps: Option<f32>,
     shadow: f32,
+    reflection: (Vec3, f32),
 ) -> Vec3 {
     if dir.y >= 0.0 {
         return sky_above(sky, dir, sun_dir) + sun_disk(sky, dir, sun_dir);
     }
     match sea_wind_mps {
-        Some(wind) => sea_radiance(sky, dir, sun_dir, wind, shadow),
+        Some(wind) => sea_radiance(sky, dir, sun_dir, wind, shadow, reflection),
         None => land_radiance(sky, dir, sun_dir, shadow),
     }
 }
@@ -422,6 +434,9 @@ pub fn background_radiance(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// No clouds in the sea's mirror.
+    const NONE: (Vec3, f32) = (Vec3::ZERO, 1.0);
 
     #[test]
     fn fresnel_goes_from_two_percent_to_all() {
@@ -446,7 +461,7 @@ mod tests {
         let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
         let at = |elev_deg: f32, az_deg: f32, wind: f32| {
             let d = -sun_direction(elev_deg, az_deg) * Vec3::new(-1.0, 1.0, -1.0);
-            sea_radiance(a, d.normalize(), sun, wind, 1.0)
+            sea_radiance(a, d.normalize(), sun, wind, 1.0, NONE)
         };
         // Away from the sun (azimuth 0), straight down and near the horizon.
         let down = lum(at(80.0, 0.0, 7.0));
@@ -468,16 +483,16 @@ mod tests {
         // cloud's shadow dims the glint.
         let up = Vec3::new(0.0, 0.5, 0.866);
         assert_eq!(
-            background_radiance(a, up, sun, Some(7.0), 0.0),
-            background_radiance(a, up, sun, None, 1.0)
+            background_radiance(a, up, sun, Some(7.0), 0.0, NONE),
+            background_radiance(a, up, sun, None, 1.0, NONE)
         );
         let d = Vec3::new(0.0, -0.5, 0.866);
         assert_ne!(
-            background_radiance(a, d, sun, Some(7.0), 1.0),
-            background_radiance(a, d, sun, None, 1.0)
+            background_radiance(a, d, sun, Some(7.0), 1.0, NONE),
+            background_radiance(a, d, sun, None, 1.0, NONE)
         );
         let g = -sun * Vec3::new(-1.0, 1.0, -1.0);
-        let shaded = lum(sea_radiance(a, g, sun, 7.0, 0.1));
+        let shaded = lum(sea_radiance(a, g, sun, 7.0, 0.1, NONE));
         assert!(shaded < 0.2 * glint, "{shaded} {glint}");
         // The land in a cloud's shadow is darker by the sun's part, and
         // keeps the sky's: on a clear day the sky gives 10-30 % of the
