@@ -12,3 +12,4 @@ pub mod lighting;
 pub mod renderer;
 pub mod sky;
 pub mod sky_luts;
+pub mod tone_map;

@@ -1,6 +1,11 @@
 //! [`CloudRenderer`]: the cloud band ray-cast as a set of wgpu passes, to
 //! embed in any wgpu application.
 //!
+//! Over 600 lines on purpose: this is the renderer's whole public API
+//! (each method documented for embedders, with the doc example), while
+//! every pass, its pipelines and targets live in their own modules; a
+//! split would scatter one type's methods over files.
+//!
 //! Passes, in order (each exists only when the scene needs it), each in
 //! its own module:
 //! 1. `terrain` (scene has terrain, [`super::terrain_pass`]): the

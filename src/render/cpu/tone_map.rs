@@ -1,0 +1,110 @@
+//! The tone map of the PNG pictures (ACES filmic, then sRGB), the twin
+//! of WGSL's `tone_map` and `aces_curve`; re-exported by `renderer`.
+
+use glam::Vec3;
+
+/// The filmic curve of ACES's reference rendering transform followed by
+/// its sRGB output transform, as Stephen Hill fitted it with one rational
+/// function per channel (applied in the transform's working space, see
+/// [`tone_map`]): 0 stays 0, mid grey 0.18 becomes 0.10, 1 becomes 0.62,
+/// and highlights roll off toward 1 (0.97 at 10) instead of clipping.
+#[inline]
+pub fn aces_curve(v: Vec3) -> Vec3 {
+    let a = v * (v + 0.024_578_6) - 0.000_090_537;
+    let b = v * (0.983_729 * v + 0.432_951) + 0.238_081;
+    a / b
+}
+
+/// sRGB (Rec. 709 primaries) to the working space of the fitted ACES
+/// transform (the sRGB-to-AP1 matrix with the RRT's saturation folded in),
+/// row by row.
+pub const ACES_INPUT: [[f32; 3]; 3] = [
+    [0.597_19, 0.354_58, 0.048_23],
+    [0.076_00, 0.908_34, 0.015_66],
+    [0.028_40, 0.133_83, 0.837_77],
+];
+
+/// The fitted transform's working space back to linear sRGB, row by row.
+pub const ACES_OUTPUT: [[f32; 3]; 3] = [
+    [1.604_75, -0.531_08, -0.073_67],
+    [-0.102_08, 1.108_13, -0.006_05],
+    [-0.003_27, -0.072_76, 1.076_02],
+];
+
+#[inline]
+fn mul_rows(m: &[[f32; 3]; 3], v: Vec3) -> Vec3 {
+    Vec3::new(
+        m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
+        m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+        m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z,
+    )
+}
+
+/// The tone map of the PNG pictures: ACES filmic (the fitted reference
+/// rendering and sRGB output transforms, [`aces_curve`]) of the linear
+/// radiance times `exposure`, to display-linear `0..1`. Bright sunlit
+/// cloud rolls off to white and desaturates as film does, instead of the
+/// grey that a per-channel exponential left it at. The images, the
+/// quality report and the GPU's composite pass (`tone_map` in WGSL) use it.
+#[inline]
+pub fn tone_map(c: Vec3, exposure: f32) -> Vec3 {
+    let v = mul_rows(&ACES_INPUT, c.max(Vec3::ZERO) * exposure);
+    mul_rows(&ACES_OUTPUT, aces_curve(v)).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+/// The sRGB transfer function of a display-linear value in `0..1`.
+#[inline]
+pub fn srgb_encode(x: f32) -> f32 {
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Tone map ([`tone_map`]) and sRGB-encode to 8 bits.
+pub fn to_srgb8(linear: &[Vec3], exposure: f32) -> Vec<u8> {
+    let enc = |x: f32| (srgb_encode(x).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    linear
+        .iter()
+        .flat_map(|&c| {
+            let m = tone_map(c, exposure);
+            [enc(m.x), enc(m.y), enc(m.z)]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fitted ACES curve's landmarks, its monotony and its roll-off:
+    /// black stays black, a neutral grey stays neutral, brighter is never
+    /// darker, and a highlight 30 times mid grey is near white but not
+    /// clipped (the old exponential map reached 0.997 there).
+    #[test]
+    fn the_tone_map_is_filmic() {
+        assert!(tone_map(Vec3::ZERO, 1.0).max_element() < 2e-3);
+        let grey = tone_map(Vec3::splat(0.18), 1.0);
+        assert!(
+            (grey.x - grey.y).abs() < 2e-3 && (grey.y - grey.z).abs() < 2e-3,
+            "{grey}"
+        );
+        assert!((0.08..0.13).contains(&grey.y), "{grey}");
+        let mut last = -1.0;
+        for i in 0..200 {
+            let x = 10f32.powf(-3.0 + 5.0 * i as f32 / 199.0);
+            let y = tone_map(Vec3::splat(x), 1.0).y;
+            assert!(y >= last, "{x}: {y} < {last}");
+            last = y;
+        }
+        let hi = tone_map(Vec3::splat(5.4), 1.0).y;
+        assert!((0.85..0.97).contains(&hi), "{hi}");
+        // Exposure scales the input.
+        assert_eq!(tone_map(Vec3::splat(0.5), 2.0), tone_map(Vec3::ONE, 1.0));
+        // A saturated bright blue is desaturated toward white, not clipped
+        // per channel into cyan.
+        let b = tone_map(Vec3::new(0.5, 1.0, 8.0), 1.0);
+        assert!(b.z < 1.0 && b.x > 0.1, "{b}");
+    }
+}
