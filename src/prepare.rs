@@ -13,12 +13,13 @@ use crate::render::cpu::density::Fields;
 use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::sky_luts::SkyLuts;
-use crate::render::gpu::baseline::Sphere;
+use crate::render::cpu::spheroids::Spheroid;
 use crate::render::gpu::headless::TARGET_FORMAT;
 use crate::render::gpu::{GpuContext, GpuError, GpuSettings, Headless};
 use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
-use crate::scene::{RenderSettings, Scene, SceneError};
+use crate::scene::{Method, RenderSettings, Scene, SceneError};
+use crate::sim::automaton::Automaton;
 use crate::sim::{Band, FramePlan, Parcels, ProjectedField, Simulation};
 
 /// A scene's textures at one moment.
@@ -28,7 +29,8 @@ pub struct Prepared {
     /// P spread to the clouds' merging scale ([`soft_field`]): what the
     /// density reads (the GPU renderer makes its own from `field`).
     pub soft: ProjectedField,
-    /// The parcels P was projected from (for the per-parcel baseline).
+    /// The parcels P was projected from (for the spheroid renderer; none
+    /// under the automaton).
     pub parcels: Parcels,
     /// The projection's fill scale (`physics.fill_full_condensed_fraction`).
     pub fill_full_condensed_fraction: f64,
@@ -53,19 +55,41 @@ impl Prepared {
         let cloud_map = CloudMap::generate(&r.cloud_map);
         let terrain = r.terrain.enabled.then(|| Heightfield::generate(&r.terrain));
         let l = scene.physics.domain_size_m;
-        let mut sim = Simulation::new(scene.physics.clone(), atm);
-        sim.set_spawn_sites(spawn_sites(&cloud_map, l));
-        let plan = FramePlan::new(scene.render.time_s, scene.physics.dt_s);
-        for k in 0..plan.frames() {
-            sim.advance(plan.frame_s(k));
-            progress();
-        }
+        let sites = spawn_sites(&cloud_map, l);
         let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
-        sim.project_into(&mut field, band);
+        let parcels = match scene.simulation.method {
+            Method::Parcels => {
+                let mut sim = Simulation::new(scene.physics.clone(), atm);
+                sim.set_spawn_sites(sites);
+                let plan = FramePlan::new(scene.render.time_s, scene.physics.dt_s);
+                for k in 0..plan.frames() {
+                    sim.advance(plan.frame_s(k));
+                    progress();
+                }
+                sim.project_into(&mut field, band);
+                sim.parcels().clone()
+            }
+            Method::Automaton => {
+                let mut a = Automaton::new(
+                    &scene.simulation.automaton,
+                    &scene.physics,
+                    band,
+                    &sites,
+                    field.width(),
+                    field.height(),
+                );
+                for _ in 0..Self::frames(scene) {
+                    a.step();
+                    progress();
+                }
+                a.project_into(&mut field);
+                Parcels::default()
+            }
+        };
         let soft = soft_field(&field, SPREAD_M, l as f32);
         Ok(Self {
             soft,
-            parcels: sim.parcels().clone(),
+            parcels,
             fill_full_condensed_fraction: scene.physics.fill_full_condensed_fraction,
             field,
             cloud_map,
@@ -84,9 +108,15 @@ impl Prepared {
     }
 
     /// Physics frames simulated before the picture (exactly `time_s`: a
-    /// short last frame when `dt_s` does not divide it).
+    /// short last frame when `dt_s` does not divide it), or the
+    /// automaton's steps (`time_s / step_s`, rounded to the nearest).
     pub fn frames(scene: &Scene) -> u64 {
-        FramePlan::new(scene.render.time_s, scene.physics.dt_s).frames()
+        match scene.simulation.method {
+            Method::Parcels => FramePlan::new(scene.render.time_s, scene.physics.dt_s).frames(),
+            Method::Automaton => {
+                (scene.render.time_s / scene.simulation.automaton.step_s).round() as u64
+            }
+        }
     }
 
     /// The GPU renderer's settings for `r` with `quality`.
@@ -158,9 +188,9 @@ impl Prepared {
         }
     }
 
-    /// The cloudy parcels as the per-parcel baseline's spheres.
-    pub fn spheres(&self) -> Vec<Sphere> {
-        spheres(&self.parcels, self.fill_full_condensed_fraction)
+    /// The cloudy parcels as the spheroid renderer's primitives.
+    pub fn spheroids(&self) -> Vec<Spheroid> {
+        spheroids(&self.parcels, self.fill_full_condensed_fraction)
     }
 }
 
@@ -174,11 +204,16 @@ pub fn spawn_sites(cloud_map: &CloudMap, extent_m: f64) -> Vec<DVec2> {
         .collect()
 }
 
-/// The cloudy, released parcels as spheres in the world frame (the
+/// Vertical semi-axis of a parcel's spheroid over its horizontal one: a
+/// cumulus element is wider than tall (their Fig. 12 flattens its
+/// spheroids about this much).
+pub const SPHEROID_ASPECT: f32 = 0.6;
+
+/// The cloudy, released parcels as pseudo-spheroids in the world frame (the
 /// physics' `(x, y, z)` is the world's `(x, z, y)`), with the fill the
-/// projection gives them. The spheres are not tiled: the domain is drawn
+/// projection gives them. The spheroids are not tiled: the domain is drawn
 /// once.
-pub fn spheres(parcels: &Parcels, fill_full_condensed_fraction: f64) -> Vec<Sphere> {
+pub fn spheroids(parcels: &Parcels, fill_full_condensed_fraction: f64) -> Vec<Spheroid> {
     let full = fill_full_condensed_fraction.max(1e-12);
     (0..parcels.len())
         .filter(|&i| parcels.diag[i].qc > 0.0 && parcels.life[i].released())
@@ -190,14 +225,14 @@ pub fn spheres(parcels: &Parcels, fill_full_condensed_fraction: f64) -> Vec<Sphe
             } else {
                 0.0
             };
-            Sphere {
+            Spheroid {
                 centre_radius: [
                     p.x as f32,
                     p.z as f32,
                     p.y as f32,
                     parcels.life[i].radius_m as f32,
                 ],
-                fill: [fill as f32, 0.0, 0.0, 0.0],
+                shape: [fill as f32, SPHEROID_ASPECT, 0.0, 0.0],
             }
         })
         .collect()

@@ -2,8 +2,8 @@
 //! needed): every WGSL function is the twin of a Rust function of the same
 //! name under `src/render/`, or on the short GPU-only list below with the
 //! reason; every WGSL constant equals its Rust twin; the `Frame` uniform's
-//! members sit at the offsets of `FrameUniforms`' fields, `Sphere`'s at
-//! those of the baseline's `Sphere`, and the sky tables' `SkyParams` and
+//! members sit at the offsets of `FrameUniforms`' fields, `Spheroid`'s at
+//! those of the spheroid renderer's `Spheroid`, and the sky tables' `SkyParams` and
 //! `SkyView` at those of `SkyParamsUniforms` and `SkyViewUniforms`. The
 //! sources are `all_variants()`, which includes `shaders/sky_luts.wgsl`.
 
@@ -11,8 +11,8 @@ use std::collections::BTreeSet;
 use std::mem::offset_of;
 use std::path::Path;
 
+use cumulus::render::cpu::spheroids::{self, Spheroid};
 use cumulus::render::cpu::{density, lighting, renderer, sky, sky_luts};
-use cumulus::render::gpu::baseline::Sphere;
 use cumulus::render::gpu::shaders::all_variants;
 use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
 
@@ -36,21 +36,16 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("sky_background", "background_radiance per pixel"),
     // Integer wrap of texel indices (rem_euclid on the CPU).
     ("wrap_i", "i64::rem_euclid on the CPU"),
-    // The per-parcel baseline exists only on the GPU, for `cumulus bench`.
-    ("march_spheres", "baseline renderer, GPU only"),
-    ("sphere_density", "baseline renderer, GPU only"),
-    ("sphere_optical_depth", "baseline renderer, GPU only"),
-    ("sphere_span", "baseline renderer, GPU only"),
-    ("sphere_hash", "baseline renderer, GPU only"),
-    ("sphere_dither", "baseline renderer, GPU only"),
-    ("sphere_value_noise", "baseline renderer, GPU only"),
-    ("sphere_noise", "baseline renderer, GPU only"),
 ];
 
 /// Every WGSL constant and its Rust twin's value.
 fn rust_constants() -> Vec<(&'static str, f64)> {
     vec![
         ("PI", std::f32::consts::PI as f64),
+        ("SPHEROID_KAPPA", spheroids::SPHEROID_KAPPA as f64),
+        ("MAX_CANDIDATES", spheroids::MAX_CANDIDATES as f64),
+        ("FBM_OCTAVES", spheroids::FBM_OCTAVES as f64),
+        ("FBM_CONTRAST", spheroids::FBM_CONTRAST as f64),
         ("BASE_RAMP", density::BASE_RAMP as f64),
         ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
@@ -251,8 +246,8 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
         sky_up, band, map, jitter, terrain, counts, mask, view_proj, prev_view_proj,
         inverse_projection, view_to_world);
     same_layout("Frame", &rust, size_of::<FrameUniforms>());
-    let rust = offsets!(Sphere: centre_radius, fill);
-    same_layout("Sphere", &rust, size_of::<Sphere>());
+    let rust = offsets!(Spheroid: centre_radius, shape);
+    same_layout("Spheroid", &rust, size_of::<Spheroid>());
 }
 
 #[test]

@@ -1,6 +1,7 @@
-//! Scene files (TOML): the atmosphere, the physics, the projection and the
-//! picture, one section type each (`atmosphere.rs`, `sim::PhysicsConfig`,
-//! `projection.rs`, `render.rs`), each checking its own values. Every key
+//! Scene files (TOML): the atmosphere, the physics, the animation method,
+//! the projection and the picture, one section type each (`atmosphere.rs`,
+//! `sim::PhysicsConfig`, `simulation.rs`, `projection.rs`, `render.rs`),
+//! each checking its own values. Every key
 //! is listed with unit and default in `docs/scene.md` (a test checks that
 //! none is missing). Errors name the file, line and key.
 
@@ -8,6 +9,7 @@ mod atmosphere;
 mod locate;
 mod projection;
 mod render;
+mod simulation;
 
 use std::path::{Path, PathBuf};
 
@@ -17,7 +19,8 @@ pub use atmosphere::AtmosphereSection;
 pub use locate::locate_key;
 use locate::{key_at_line, line_col};
 pub use projection::ProjectionSection;
-pub use render::RenderSettings;
+pub use render::{RenderMethod, RenderSettings};
+pub use simulation::{Method, SimulationSection};
 
 use crate::sim::lift::surface_lcl_height;
 use crate::sim::{Atmosphere, Band, PhysicsConfig, Sounding, SoundingError};
@@ -59,6 +62,7 @@ pub struct Scene {
     pub description: String,
     pub atmosphere: AtmosphereSection,
     pub physics: PhysicsConfig,
+    pub simulation: SimulationSection,
     pub projection: ProjectionSection,
     pub render: RenderSettings,
     /// Where the scene was read from (not a key).
@@ -149,12 +153,23 @@ impl Scene {
     pub fn validate(&self) -> Result<(), SceneError> {
         let checks = [
             self.physics.checks(),
+            self.simulation.checks(),
             self.projection.size_checks(),
             self.render.checks(),
             self.atmosphere.override_checks(),
             self.projection.band_checks(),
             self.atmosphere.profile_checks(),
         ];
+        if self.simulation.method == Method::Automaton
+            && self.render.renderer == RenderMethod::Spheroids
+        {
+            return Err(self.invalid(
+                "render.renderer",
+                "is \"spheroids\", which draws parcels, but simulation.method = \"automaton\" \
+                 has none: use \"cloud_map\""
+                    .into(),
+            ));
+        }
         match checks.into_iter().flatten().find(|c| !c.ok) {
             None => Ok(()),
             Some(c) => {
@@ -229,6 +244,7 @@ impl Scene {
             && strip(self) == strip(other)
             && resolve(self) == resolve(other)
             && self.physics == other.physics
+            && self.simulation == other.simulation
             && self.projection == other.projection
             && self.render == other.render
     }
@@ -294,6 +310,32 @@ mod tests {
             e.to_string(),
             "s.toml:3: `physics.radius_m`: is -5, expected a radius > 0 m"
         );
+    }
+
+    #[test]
+    fn the_automaton_s_keys_are_checked_and_spheroids_need_parcels() {
+        let e = Scene::parse(
+            "[simulation]\nmethod = \"automaton\"\n\n[simulation.automaton]\nextinction = 1.5\n",
+            Path::new("s.toml"),
+        )
+        .expect_err("probability above 1");
+        assert_eq!(
+            e.to_string(),
+            "s.toml:5: `simulation.automaton.extinction`: is 1.5, expected a probability in 0..=1"
+        );
+        let e = Scene::parse(
+            "[simulation]\nmethod = \"automaton\"\n\n[render]\nrenderer = \"spheroids\"\n",
+            Path::new("s.toml"),
+        )
+        .expect_err("no parcels to draw");
+        assert!(
+            e.to_string()
+                .starts_with("s.toml:5: `render.renderer`: is \"spheroids\""),
+            "{e}"
+        );
+        let s = Scene::parse("[render]\nrenderer = \"spheroids\"\n", Path::new("s.toml"))
+            .expect("spheroids over parcels");
+        assert_eq!(s.render.renderer, RenderMethod::Spheroids);
     }
 
     #[test]

@@ -13,10 +13,26 @@ use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::TerrainConfig;
 use crate::sim::{Band, Check};
 
+/// The renderer a scene draws its clouds with (`[render] renderer`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RenderMethod {
+    /// P and the cloud map (Goswami 2019).
+    #[default]
+    CloudMap,
+    /// A pseudo-spheroid per cloudy parcel (Jimenez de Parga & Gomez
+    /// Palomo 2018).
+    Spheroids,
+}
+
 /// The `[render]` scene table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RenderSettings {
+    /// Which renderer draws the clouds: `"cloud_map"` (default: P and the
+    /// cloud map, Goswami 2019) or `"spheroids"` (each cloudy parcel a
+    /// pseudo-spheroid, Jimenez de Parga & Gomez Palomo 2018).
+    pub renderer: RenderMethod,
     /// Image width, pixels (1..=8192). Default 640.
     pub width: u32,
     /// Image height, pixels (1..=8192). Default 480.
@@ -89,6 +105,7 @@ pub struct RenderSettings {
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
+            renderer: RenderMethod::CloudMap,
             width: 640,
             height: 480,
             camera_position_m: [0.0, 100.0, 0.0],

@@ -2,6 +2,7 @@
 //! or egui): researchers can use it on its own.
 
 pub mod atmosphere;
+pub mod automaton;
 pub mod budget;
 pub mod check;
 pub mod config;

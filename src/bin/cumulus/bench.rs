@@ -20,6 +20,11 @@ pub struct BenchArgs {
     /// enough for CI on software Vulkan.
     #[arg(long)]
     quick: bool,
+    /// Only the methods side by side (methods.csv and bench.json): the
+    /// cloud map fed by the parcels and by the automaton, and the
+    /// pseudo-spheroids, at the scene's 640x480.
+    #[arg(long)]
+    methods: bool,
     /// Timed frames per configuration (default 30; 3 with --quick).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: Option<u32>,
@@ -45,12 +50,38 @@ pub fn run(a: BenchArgs) -> Result<()> {
         frames: a.frames.unwrap_or(if a.quick { 3 } else { 30 }),
         warmup: a.warmup.unwrap_or(if a.quick { 1 } else { 5 }),
         max_frame_s: a.max_frame_s.unwrap_or(if a.quick { 2.0 } else { 20.0 }),
+        methods_only: a.methods,
     };
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
     crate::guard_output_dir(&a.out);
     let report = gpu_bench::run(&ctx, &scene, &o, |line| eprintln!("{line}"))?;
     gpu_bench::write(&report, &a.out)?;
+    if !report.rows.is_empty() {
+        print_sweeps(&report);
+    }
+    println!("methods side by side (frame on the GPU; step and light grid on the CPU):");
+    for m in &report.methods {
+        println!(
+            "  {:<9} + {:<9} {}x{}: frame median {:.2} ms, p95 {:.2} ms ({}); step {:.3} ms per {} s; light grid {:.1} ms",
+            m.method,
+            m.renderer,
+            m.width,
+            m.height,
+            m.median_ms,
+            m.p95_ms,
+            m.timing,
+            m.step_ms,
+            m.step_s,
+            m.light_grid_ms
+        );
+    }
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
+
+/// The sweeps' table, the speed ratios and the physics' share.
+fn print_sweeps(report: &cumulus::report::gpu_bench::Report) {
     println!(
         "{:<11} {:<10} {:>9} {:>8} {:>7} {:>9} {:>9} {:>10} {:>10} {:>6}",
         "group",
@@ -99,6 +130,4 @@ pub fn run(a: BenchArgs) -> Result<()> {
             p.parcels, p.physics_ms, p.projection_ms, p.upload_ms, p.share_pct, p.frame_ms
         );
     }
-    println!("wrote {}", a.out.display());
-    Ok(())
 }

@@ -52,7 +52,7 @@ enum Command {
     #[command(allow_negative_numbers = true)]
     Render(render::RenderArgs),
     /// GPU frame benchmarks: resolution, coverage, parcel count (cloud map
-    /// against a per-parcel baseline), features, the physics' share of the
+    /// against the per-parcel pseudo-spheroids), features, the physics' share of the
     /// frame, and render error against GPU time. Writes CSV, JSON and PNGs.
     #[command(allow_negative_numbers = true)]
     Bench(bench::BenchArgs),

@@ -9,7 +9,7 @@ use cumulus::io::write_png_atomically;
 use cumulus::prepare::Prepared;
 use cumulus::render::gpu::GpuContext;
 use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
-use cumulus::scene::Scene;
+use cumulus::scene::{RenderMethod, Scene};
 
 use crate::{
     check_output_file, gpu_context, guard_output_dir, guard_output_file, load_scene, progress_bar,
@@ -208,6 +208,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
             dir.display()
         );
     }
+    if r.renderer == RenderMethod::Spheroids {
+        return render_spheroids(gpu.as_ref(), &a, &scene, &prepared, picture);
+    }
     if let Some(ctx) = &gpu {
         return render_gpu(ctx, &a, &scene, &prepared, picture);
     }
@@ -311,5 +314,74 @@ fn render_gpu(
             }
         }
     }
+    Ok(())
+}
+
+/// `render` with `[render] renderer = "spheroids"`: the pseudo-spheroid
+/// renderer on the GPU, or its CPU twin.
+fn render_spheroids(
+    gpu: Option<&GpuContext>,
+    a: &RenderArgs,
+    scene: &Scene,
+    prepared: &Prepared,
+    picture: Option<Picture>,
+) -> Result<()> {
+    use cumulus::render::cpu::renderer::to_srgb8;
+    use cumulus::render::cpu::sky::sun_direction;
+    use cumulus::render::cpu::spheroids::{LightGrid, render_spheroids as cpu_render};
+    use cumulus::render::gpu::spheroids::SpheroidRenderer;
+
+    let r = &scene.render;
+    if a.time_frames.is_some() {
+        bail!(
+            "--time-frames times the cloud map; `cumulus bench` times the spheroids (methods.csv)"
+        );
+    }
+    let Some(out) = &a.out else { return Ok(()) };
+    let spheroids = prepared.spheroids();
+    let start = std::time::Instant::now();
+    let rgb8 = match gpu {
+        Some(ctx) => {
+            if picture == Some(Picture::Exr) {
+                bail!(
+                    "{}: the spheroid renderer writes PNG on the GPU; use --backend cpu for OpenEXR",
+                    out.display()
+                );
+            }
+            eprintln!("backend: gpu ({})", ctx.describe());
+            let settings = prepared.gpu_settings(r, r.quality());
+            let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+            s.update_spheroids(&spheroids);
+            s.read_rgb8(ctx, &r.camera(), r.width, r.height)?
+        }
+        None => {
+            let frame = prepared.frame(r, r.quality());
+            let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
+            let grid = LightGrid::build(&spheroids, sun, frame.density.extinction_per_m);
+            let linear = cpu_render(r.width, r.height, &frame, &spheroids, &grid);
+            if picture == Some(Picture::Exr) {
+                let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
+                write_exr(out, r.width, r.height, rgb)?;
+                eprintln!(
+                    "rendered {} spheroids; wrote {}",
+                    spheroids.len(),
+                    out.display()
+                );
+                return Ok(());
+            }
+            to_srgb8(&linear, r.exposure)
+        }
+    };
+    let img = image::RgbImage::from_raw(r.width, r.height, rgb8).context("image buffer size")?;
+    write_png_atomically(out, &img)
+        .with_context(|| format!("{}: cannot write image", out.display()))?;
+    eprintln!(
+        "rendered {}x{} with {} pseudo-spheroids in {:.2} s; wrote {}",
+        r.width,
+        r.height,
+        spheroids.len(),
+        start.elapsed().as_secs_f64(),
+        out.display()
+    );
     Ok(())
 }

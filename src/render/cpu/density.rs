@@ -285,7 +285,7 @@ pub fn domain_warp(x: f32, z: f32, extent_m: f32) -> (f32, f32) {
 /// Distances from the simulated domain's centre, in domain widths, over
 /// which the warp and the weather grow from nothing to full: the
 /// simulated copy of the domain (its corners are 0.71 from the centre) is
-/// drawn where its parcels are, as P says (the per-parcel baseline and an
+/// drawn where its parcels are, as P says (the per-parcel spheroids and an
 /// application's own use of the parcels agree with the picture), and the
 /// copies around it are warped. A slower ramp (to 2.0 or 2.5) left the
 /// period visible in `cumulus stats`' repetition measure.

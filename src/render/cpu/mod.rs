@@ -12,4 +12,5 @@ pub mod lighting;
 pub mod renderer;
 pub mod sky;
 pub mod sky_luts;
+pub mod spheroids;
 pub mod tone_map;

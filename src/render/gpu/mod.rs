@@ -2,7 +2,6 @@
 //! library to embed in a wgpu application ([`CloudRenderer`]), plus a
 //! headless path for `cumulus render --backend gpu` and the tests.
 
-pub mod baseline;
 mod bind;
 mod cloud_pass;
 mod composite_pass;
@@ -13,6 +12,7 @@ pub mod renderer;
 pub mod settings;
 pub mod shaders;
 pub mod sky_luts_pass;
+pub mod spheroids;
 mod terrain_pass;
 pub mod textures;
 pub mod timer;

@@ -110,13 +110,13 @@ pub fn terrain_pass(physical: bool) -> String {
     format!("{}{TERRAIN}", shared(physical))
 }
 
-/// The per-parcel baseline's source (`cumulus bench` only; its one bind
-/// group 0 holds the uniforms alone, so it draws under the analytic sky).
-pub fn baseline_pass() -> String {
+/// The spheroid renderer's source (its bind group 0 holds the uniforms
+/// alone, so it draws under the analytic sky).
+pub fn spheroids_pass() -> String {
     format!(
         "{}{COMPOSITE}\n{}",
         shared(false),
-        super::baseline::BASELINE
+        super::spheroids::SPHEROIDS
     )
 }
 
@@ -127,9 +127,9 @@ pub fn sky_luts_pass() -> String {
 
 /// Every variant's source: under each sky model, the cloud pass with and
 /// without depth and TSAA, the composite pass over each background and
-/// the terrain; TSAA, the baseline and the sky tables.
+/// the terrain; TSAA, the spheroids and the sky tables.
 pub fn all_variants() -> Vec<String> {
-    let mut sources = vec![tsaa_pass(), baseline_pass(), sky_luts_pass()];
+    let mut sources = vec![tsaa_pass(), spheroids_pass(), sky_luts_pass()];
     for physical in [false, true] {
         sources.push(terrain_pass(physical));
         for depth in [false, true] {

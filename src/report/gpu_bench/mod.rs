@@ -1,10 +1,12 @@
 //! `cumulus bench`: GPU frame times across resolution, coverage, parcel
 //! count and features, for the cloud-map renderer and the per-parcel
-//! baseline; the physics' share of the frame; and rendering error against
-//! run time. Results as CSV, JSON and plots. `timing.rs` times one
-//! configuration, `physics_share.rs` the physics against the frame,
-//! `quality.rs` the error against GPU time, `write.rs` the files.
+//! pseudo-spheroid renderer; the physics' share of the frame; the methods
+//! side by side; and rendering error against run time. Results as CSV,
+//! JSON and plots. `timing.rs` times one configuration,
+//! `physics_share.rs` the physics against the frame, `methods.rs` the
+//! methods, `quality.rs` the error against GPU time, `write.rs` the files.
 
+mod methods;
 mod physics_share;
 mod quality;
 mod timing;
@@ -20,9 +22,10 @@ use crate::prepare::Prepared;
 use crate::render::cpu::sky::SkyModel;
 use crate::render::gpu::{GpuContext, GpuError};
 use crate::scene::{RenderSettings, Scene, SceneError};
+use methods::compare_methods;
 use physics_share::physics_in_frame;
 use quality::quality_sweep;
-use timing::{row, time_baseline, time_cloud_map};
+use timing::{row, time_cloud_map, time_spheroids};
 
 /// Errors of the benchmark.
 #[derive(Debug, thiserror::Error)]
@@ -48,6 +51,8 @@ pub struct BenchOptions {
     /// this (from the previous parcel count, the cost being linear) is
     /// skipped and reported as skipped, s.
     pub max_frame_s: f64,
+    /// Only the methods side by side (`methods.csv`), nothing else.
+    pub methods_only: bool,
 }
 
 /// Coverages of the cloud-map paper's Table 1.
@@ -108,6 +113,29 @@ pub struct PhysicsRow {
     pub share_pct: f64,
 }
 
+/// One method on the base scene: its frame, its simulation step and
+/// (spheroids) its light grid's build.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodRow {
+    /// The animation: "parcels" or "automaton".
+    pub method: &'static str,
+    /// The renderer: "cloud_map" or "spheroids".
+    pub renderer: &'static str,
+    pub width: u32,
+    pub height: u32,
+    /// Fraction of P's texels with coverage.
+    pub p_covered: f64,
+    pub median_ms: f64,
+    pub p95_ms: f64,
+    pub timing: &'static str,
+    /// One simulation step (CPU wall time, median), ms.
+    pub step_ms: f64,
+    /// Seconds of sky one step advances.
+    pub step_s: f64,
+    /// The light grid's CPU build (spheroids only), ms.
+    pub light_grid_ms: f64,
+}
+
 /// Rendering error against run time: one knob varied, the others at the
 /// scene's defaults.
 #[derive(Debug, Clone, Serialize)]
@@ -133,13 +161,15 @@ pub struct Report {
     pub quick: bool,
     pub rows: Vec<Row>,
     pub physics: Vec<PhysicsRow>,
+    /// The methods side by side ([`MethodRow`]).
+    pub methods: Vec<MethodRow>,
     pub quality: Vec<QualityRow>,
     /// Quality images' size.
     pub quality_size: [u32; 2],
 }
 
 impl Report {
-    /// The cloud-map against baseline speed ratio at `parcels` (baseline
+    /// The cloud-map against per-parcel speed ratio at `parcels` (per-parcel
     /// ms / cloud-map ms), when both ran.
     pub fn ratio_at(&self, parcels: usize) -> Option<f64> {
         let find = |r: &str| {
@@ -210,6 +240,19 @@ pub fn run(
     } else {
         RESOLUTIONS.to_vec()
     };
+    if o.methods_only {
+        let methods = compare_methods(ctx, &base, o, &mut progress)?;
+        let timing = methods.first().map_or("wall", |m| m.timing);
+        return Ok(report(
+            ctx,
+            o,
+            timing,
+            Vec::new(),
+            Vec::new(),
+            methods,
+            (Vec::new(), [0, 0]),
+        ));
+    }
     let mut rows = Vec::new();
     let sc = base.clone();
     let p = Prepared::from_scene(&sc, || {})?;
@@ -264,7 +307,7 @@ pub fn run(
     }
 
     let mut physics = Vec::new();
-    let mut last_baseline: Option<(usize, f64)> = None;
+    let mut last_per_parcel: Option<(usize, f64)> = None;
     for n in PARCELS {
         let (scn, pn) = prepare(&base, n)?;
         let r = &scn.render;
@@ -272,17 +315,17 @@ pub fn run(
         let t = time_cloud_map(ctx, &pn, r, o)?;
         let frame_ms = t.median();
         rows.push(row("parcels", "cloud_map", r, &pn, Some(&t), o.frames));
-        let predicted_s = last_baseline.map(|(m, ms)| ms * n as f64 / m as f64 * 1e-3);
+        let predicted_s = last_per_parcel.map(|(m, ms)| ms * n as f64 / m as f64 * 1e-3);
         if predicted_s.is_some_and(|s| s > o.max_frame_s) {
             progress(&format!(
-                "parcels {n}: per-parcel baseline skipped (predicted {:.0} s a frame)",
+                "parcels {n}: spheroids skipped (predicted {:.0} s a frame)",
                 predicted_s.unwrap_or(0.0)
             ));
             rows.push(row("parcels", "per_parcel", r, &pn, None, 0));
         } else {
-            progress(&format!("parcels {n}: per-parcel baseline"));
-            let tb = time_baseline(ctx, &pn, r, o)?;
-            last_baseline = Some((n, tb.median()));
+            progress(&format!("parcels {n}: spheroids"));
+            let tb = time_spheroids(ctx, &pn, r, o)?;
+            last_per_parcel = Some((n, tb.median()));
             rows.push(row("parcels", "per_parcel", r, &pn, Some(&tb), o.frames));
         }
         physics.push(physics_in_frame(
@@ -293,14 +336,35 @@ pub fn run(
             if o.quick { 3 } else { 20 },
         )?);
     }
+    let methods = compare_methods(ctx, &base, o, &mut progress)?;
     progress("render error against run time");
     let (quality, quality_size) = quality_sweep(ctx, &sc, &p, o)?;
     let timing = rows
         .iter()
         .find(|r| r.timing != "skipped")
         .map_or("wall", |r| r.timing);
+    Ok(report(
+        ctx,
+        o,
+        timing,
+        rows,
+        physics,
+        methods,
+        (quality, quality_size),
+    ))
+}
+
+fn report(
+    ctx: &GpuContext,
+    o: &BenchOptions,
+    timing: &'static str,
+    rows: Vec<Row>,
+    physics: Vec<PhysicsRow>,
+    methods: Vec<MethodRow>,
+    (quality, quality_size): (Vec<QualityRow>, [u32; 2]),
+) -> Report {
     let i = &ctx.adapter_info;
-    Ok(Report {
+    Report {
         adapter: i.name.clone(),
         backend: format!("{:?}", i.backend),
         device_type: format!("{:?}", i.device_type),
@@ -310,7 +374,8 @@ pub fn run(
         quick: o.quick,
         rows,
         physics,
+        methods,
         quality,
         quality_size,
-    })
+    }
 }

@@ -1,11 +1,11 @@
-//! Timing one configuration: the cloud-map renderer or the per-parcel
-//! baseline, and the row that reports it.
+//! Timing one configuration: the cloud-map renderer or the spheroid
+//! renderer, and the row that reports it.
 
 use super::{BenchOptions, Row};
 use crate::prepare::Prepared;
 use crate::render::cpu::sky::SkyModel;
-use crate::render::gpu::baseline::BaselineRenderer;
 use crate::render::gpu::headless::TARGET_FORMAT;
+use crate::render::gpu::spheroids::SpheroidRenderer;
 use crate::render::gpu::timer::{FrameTimes, time_frames};
 use crate::render::gpu::{GpuContext, GpuError, textures};
 use crate::scene::RenderSettings;
@@ -46,16 +46,16 @@ pub(super) fn time_cloud_map(
     hl.time_frames(ctx, &r.camera(), o.warmup, o.frames)
 }
 
-/// Times the per-parcel baseline on `p`'s parcels with `r`.
-pub(super) fn time_baseline(
+/// Times the spheroid renderer on `p`'s parcels with `r`.
+pub(super) fn time_spheroids(
     ctx: &GpuContext,
     p: &Prepared,
     r: &RenderSettings,
     o: &BenchOptions,
 ) -> Result<FrameTimes, GpuError> {
     let settings = p.gpu_settings(r, r.quality());
-    let mut b = BaselineRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
-    b.update_spheres(&p.spheres());
+    let mut b = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+    b.update_spheroids(&p.spheroids());
     b.resize(r.width, r.height);
     let target = textures::create_2d(
         &ctx.device,

@@ -7,7 +7,7 @@ use crate::io::write_atomically;
 use crate::report::ReportError;
 use crate::report::plot::{Series, bars_png, loglog_png};
 
-/// Writes `bench.csv`, `physics_in_frame.csv`, `render_error.csv`,
+/// Writes `bench.csv`, `physics_in_frame.csv`, `methods.csv`, `render_error.csv`,
 /// `bench.json` and the plots into `dir`.
 pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     let path = dir.join("bench.csv");
@@ -39,6 +39,19 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         Ok(())
     })
     .map_err(ReportError::writing(&path))?;
+    let path = dir.join("methods.csv");
+    write_atomically(&path, |out| {
+        writeln!(out, "method,renderer,width,height,p_covered,median_ms,p95_ms,timing,step_ms,step_s,light_grid_ms")?;
+        for r in &report.methods {
+            writeln!(
+                out,
+                "{},{},{},{},{:.4},{:.4},{:.4},{},{:.4},{},{:.3}",
+                r.method, r.renderer, r.width, r.height, r.p_covered, r.median_ms, r.p95_ms, r.timing, r.step_ms, r.step_s, r.light_grid_ms
+            )?;
+        }
+        Ok(())
+    })
+    .map_err(ReportError::writing(&path))?;
     let path = dir.join("render_error.csv");
     write_atomically(&path, |out| {
         writeln!(out, "knob,value,ms,mean_abs_error,is_default")?;
@@ -59,6 +72,10 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     })
     .map_err(ReportError::writing(&path))?;
 
+    if report.rows.is_empty() {
+        // A methods-only run: no sweeps to plot.
+        return Ok(());
+    }
     let device = format!("{} ({} timing)", report.adapter, report.timing);
     let series_of = |group: &str, renderer: &str, x: fn(&Row) -> f64| Series {
         joined: true,

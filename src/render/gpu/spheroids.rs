@@ -1,0 +1,261 @@
+//! The per-primitive renderer: each cloudy parcel a pseudo-spheroid
+//! (Jimenez de Parga & Gomez Palomo 2018), lit from a light grid the CPU
+//! precomputes (`render::cpu::spheroids`, the twin of every WGSL
+//! function). `cumulus bench` compares the cloud map against it, and
+//! `[render] renderer = "spheroids"` draws a scene with it. Each pixel
+//! tests every spheroid once, so its cost grows with the parcel count,
+//! unlike the cloud-map pass. Same lighting, analytic sky and tone map
+//! (`shaders/spheroids.wgsl` calls the cloud pass's functions).
+
+use super::bind::{self, Recorder};
+use super::settings::GpuSettings;
+use super::uniforms::{FrameInputs, FrameUniforms};
+use crate::render::camera::Camera;
+
+use crate::render::cpu::sky::sun_direction;
+use crate::render::cpu::spheroids::LightGrid;
+pub use crate::render::cpu::spheroids::Spheroid;
+
+/// The spheroid renderer's WGSL.
+pub const SPHEROIDS: &str = include_str!("../../../shaders/spheroids.wgsl");
+
+/// The spheroid renderer: one full-screen pass straight into the target.
+pub struct SpheroidRenderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    settings: GpuSettings,
+    uniforms: wgpu::Buffer,
+    group0: wgpu::BindGroup,
+    group1_layout: wgpu::BindGroupLayout,
+    group1: wgpu::BindGroup,
+    buffer: wgpu::Buffer,
+    grid_buffer: wgpu::Buffer,
+    count: usize,
+    grid_words: usize,
+    grid_ms: f64,
+    format: wgpu::TextureFormat,
+    pipeline: wgpu::RenderPipeline,
+    width: u32,
+    height: u32,
+}
+
+impl SpheroidRenderer {
+    /// The renderer for a target of `format` (its settings' quality,
+    /// density scale, detail and sun are the cloud-map renderer's).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        format: wgpu::TextureFormat,
+        settings: &GpuSettings,
+    ) -> Self {
+        let uniforms = bind::uniform_buffer(device, "spheroids.frame_uniforms");
+        let group0_layout = bind::layout(device, "spheroids.group0", &[bind::uniform_entry(0)]);
+        let group1_layout = bind::layout(
+            device,
+            "spheroids.primitives",
+            &[bind::storage_entry(0), bind::storage_entry(1)],
+        );
+        let group0 = bind::bind(
+            device,
+            "spheroids.group0",
+            &group0_layout,
+            &[uniforms.as_entire_binding()],
+        );
+        let module = bind::module(device, "spheroids", super::shaders::spheroids_pass());
+        let mut constants = settings.constants();
+        constants.push(("ENCODE_SRGB", (!format.is_srgb()) as u8 as f64));
+        constants.push((
+            "TONE_MAP",
+            (!super::composite_pass::is_hdr(format)) as u8 as f64,
+        ));
+        let pipeline = bind::full_screen_pipeline(
+            device,
+            "spheroids",
+            &module,
+            &[&group0_layout, &group1_layout],
+            &[Some(format.into())],
+            Some("fs_spheroids"),
+            &constants,
+        );
+        let buffer = Self::storage(device, "spheroids.spheroids", 32);
+        let grid_buffer = Self::storage(device, "spheroids.light_grid", 16);
+        let group1 = Self::bind_primitives(device, &group1_layout, &buffer, &grid_buffer);
+        let mut r = Self {
+            device: device.clone(),
+            queue: queue.clone(),
+            settings: *settings,
+            uniforms,
+            group0,
+            group1_layout,
+            group1,
+            buffer,
+            grid_buffer,
+            count: 0,
+            grid_words: 0,
+            grid_ms: 0.0,
+            format,
+            pipeline,
+            width: 1,
+            height: 1,
+        };
+        r.update_spheroids(&[]);
+        r
+    }
+
+    fn storage(device: &wgpu::Device, label: &str, bytes: usize) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    fn bind_primitives(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        spheroids: &wgpu::Buffer,
+        grid: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        bind::bind(
+            device,
+            "spheroids.primitives",
+            layout,
+            &[spheroids.as_entire_binding(), grid.as_entire_binding()],
+        )
+    }
+
+    /// Uploads the spheroids (none: one empty spheroid far below the
+    /// ground) and builds and uploads their light grid for the settings'
+    /// sun and extinction (timed: [`Self::light_grid_ms`]).
+    pub fn update_spheroids(&mut self, spheroids: &[Spheroid]) {
+        let empty = [Spheroid {
+            centre_radius: [0.0, -1e7, 0.0, 1.0],
+            shape: [0.0, 1.0, 0.0, 0.0],
+        }];
+        let data = if spheroids.is_empty() {
+            &empty[..]
+        } else {
+            spheroids
+        };
+        let start = std::time::Instant::now();
+        let sun = sun_direction(
+            self.settings.sun_elevation_deg,
+            self.settings.sun_azimuth_deg,
+        );
+        let grid = LightGrid::build(spheroids, sun, self.settings.density.extinction_per_m);
+        let words = grid.to_words();
+        self.grid_ms = start.elapsed().as_secs_f64() * 1e3;
+        if data.len() != self.count || words.len() != self.grid_words {
+            self.buffer = Self::storage(&self.device, "spheroids.spheroids", size_of_val(data));
+            self.grid_buffer = Self::storage(&self.device, "spheroids.light_grid", words.len() * 4);
+            self.group1 = Self::bind_primitives(
+                &self.device,
+                &self.group1_layout,
+                &self.buffer,
+                &self.grid_buffer,
+            );
+            self.count = data.len();
+            self.grid_words = words.len();
+        }
+        self.queue
+            .write_buffer(&self.buffer, 0, bytemuck::cast_slice(data));
+        self.queue
+            .write_buffer(&self.grid_buffer, 0, bytemuck::cast_slice(&words));
+    }
+
+    /// The CPU time of the last light grid's build, ms (the paper's
+    /// illumination pass).
+    pub fn light_grid_ms(&self) -> f64 {
+        self.grid_ms
+    }
+
+    /// The target's size.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        self.width = width;
+        self.height = height;
+    }
+
+    /// Records the frame; with `timestamps`, writes queries 0 and 1.
+    pub fn render(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        camera: &Camera,
+        timestamps: Option<&wgpu::QuerySet>,
+    ) {
+        if self.width == 0 || self.height == 0 {
+            return;
+        }
+        let aspect = self.width as f32 / self.height as f32;
+        let u = FrameUniforms::new(&FrameInputs {
+            view: camera.view(aspect, self.settings.quality.max_distance_m),
+            depth_flipped: false,
+            prev_view_proj: glam::Mat4::IDENTITY,
+            width: self.width,
+            height: self.height,
+            sun_elevation_deg: self.settings.sun_elevation_deg,
+            sun_azimuth_deg: self.settings.sun_azimuth_deg,
+            density: self.settings.density,
+            quality: self.settings.quality,
+            jitter: [0.0; 3],
+            blend: 1.0,
+            frame_index: 0,
+            terrain: [0.0; 2],
+            p_size: [1, 1],
+            mask: [1, 1, 1, 0],
+            map_size: 1,
+        });
+        self.queue
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        let mut rec = Recorder::new(encoder, timestamps);
+        let mut pass = rec.begin(
+            "spheroids",
+            &[bind::color_attachment(target, Some(wgpu::Color::BLACK))],
+            None,
+        );
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group0, &[]);
+        pass.set_bind_group(1, &self.group1, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+impl SpheroidRenderer {
+    /// Renders one frame from `camera` into a new `width x height` target
+    /// of the renderer's format and reads it back as 8-bit RGB, row-major
+    /// (`Err` for other than an RGBA8 format: read those yourself).
+    pub fn read_rgb8(
+        &mut self,
+        ctx: &super::GpuContext,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, super::GpuError> {
+        use wgpu::TextureFormat::{Rgba8Unorm, Rgba8UnormSrgb};
+        if !matches!(self.format, Rgba8Unorm | Rgba8UnormSrgb) {
+            return Err(super::GpuError::Readback(format!(
+                "the spheroid renderer reads back RGBA8 targets, not {:?}",
+                self.format
+            )));
+        }
+        self.resize(width, height);
+        let target = super::textures::create_2d(
+            &ctx.device,
+            "spheroids.target",
+            width,
+            height,
+            self.format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let view = target.create_view(&Default::default());
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        self.render(&mut e, &view, camera, None);
+        ctx.queue.submit([e.finish()]);
+        let px = ctx.read_texture(&target, 4)?;
+        Ok(px
+            .chunks_exact(4)
+            .flat_map(|q| [q[0], q[1], q[2]])
+            .collect())
+    }
+}
