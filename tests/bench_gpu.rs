@@ -113,6 +113,28 @@ fn bench_quick_writes_well_formed_results() {
     }
     assert_eq!(n, 4, "12, 85, 1,000 and 10,000 parcels");
 
+    // The methods side by side: one row each, every time positive.
+    let mut r = csv::Reader::from_path(dir.path().join("methods.csv")).unwrap();
+    let mut methods = Vec::new();
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        methods.push(format!("{}+{}", &rec[0], &rec[1]));
+        for k in [5, 6, 8, 9] {
+            let v: f64 = rec[k].parse().unwrap();
+            assert!(v.is_finite() && v > 0.0, "methods.csv {rec:?} column {k}");
+        }
+        let grid: f64 = rec[10].parse().unwrap();
+        assert_eq!(grid > 0.0, &rec[1] == "spheroids", "{rec:?}");
+    }
+    assert_eq!(
+        methods,
+        [
+            "parcels+cloud_map",
+            "parcels+spheroids",
+            "automaton+cloud_map"
+        ]
+    );
+
     let mut r = csv::Reader::from_path(dir.path().join("render_error.csv")).unwrap();
     let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
     for knob in ["steps", "shadow_steps", "octaves", "tsaa_frames"] {
