@@ -32,7 +32,7 @@ bin=target/release/cumulus
 
 echo "== gallery (README 'The two commands')"
 for s in fair_weather bomex evening strong_inversion \
-  view_high_flight view_backlit view_below_base view_horizon automaton spheroids; do
+  view_high_flight view_backlit view_below_base view_horizon automaton spheroids endless; do
   "$bin" render --scene "scenes/$s.toml" --out "docs/$s.png"
 done
 

@@ -20,6 +20,7 @@
 //! assert!(sim.parcels().pos.iter().all(|x| x.is_finite()));
 //! ```
 
+pub mod endless;
 pub mod io;
 pub mod panel;
 pub mod prepare;

@@ -58,7 +58,7 @@ impl Prepared {
         let sites = spawn_sites(&cloud_map, l);
         let mut field = ProjectedField::new(scene.projection.width, scene.projection.height);
         let parcels = match scene.simulation.method {
-            Method::Parcels => {
+            Method::Parcels | Method::Endless => {
                 let mut sim = Simulation::new(scene.physics.clone(), atm);
                 sim.set_spawn_sites(sites);
                 let plan = FramePlan::new(scene.render.time_s, scene.physics.dt_s);
@@ -100,6 +100,46 @@ impl Prepared {
         })
     }
 
+    /// The scene's parcels (whatever its method) at `count` moments
+    /// `interval_s` apart, the first after `render.time_s`: `each` gets
+    /// the moment's index and its fields (one simulation, P projected
+    /// anew each time). `progress` is called after every physics frame.
+    pub fn snapshots(
+        scene: &Scene,
+        interval_s: f64,
+        count: usize,
+        mut each: impl FnMut(usize, &Prepared),
+        mut progress: impl FnMut(),
+    ) -> Result<(), SceneError> {
+        // The textures without the simulation, which runs here.
+        let mut bare = scene.clone();
+        bare.simulation.method = Method::Parcels;
+        bare.render.time_s = 0.0;
+        let atm = scene.atmosphere(None)?;
+        let mut p = Self::from_scene(&bare, || {})?;
+        let mut sim = Simulation::new(scene.physics.clone(), atm);
+        sim.set_spawn_sites(spawn_sites(&p.cloud_map, p.map_extent_m));
+        let plan = FramePlan::new(scene.render.time_s, scene.physics.dt_s);
+        for k in 0..plan.frames() {
+            sim.advance(plan.frame_s(k));
+            progress();
+        }
+        let step = FramePlan::new(interval_s, scene.physics.dt_s);
+        for v in 0..count {
+            if v > 0 {
+                for k in 0..step.frames() {
+                    sim.advance(step.frame_s(k));
+                    progress();
+                }
+            }
+            sim.project_into(&mut p.field, p.band);
+            p.soft = soft_field(&p.field, SPREAD_M, p.map_extent_m as f32);
+            p.parcels = sim.parcels().clone();
+            each(v, &p);
+        }
+        Ok(())
+    }
+
     /// Drops the physical sky's CPU tables, for a frame with another sun
     /// or camera altitude than the first one's (the next [`Self::frame`]
     /// builds them anew).
@@ -112,7 +152,9 @@ impl Prepared {
     /// automaton's steps (`time_s / step_s`, rounded to the nearest).
     pub fn frames(scene: &Scene) -> u64 {
         match scene.simulation.method {
-            Method::Parcels => FramePlan::new(scene.render.time_s, scene.physics.dt_s).frames(),
+            Method::Parcels | Method::Endless => {
+                FramePlan::new(scene.render.time_s, scene.physics.dt_s).frames()
+            }
             Method::Automaton => {
                 (scene.render.time_s / scene.simulation.automaton.step_s).round() as u64
             }

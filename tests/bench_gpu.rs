@@ -9,14 +9,18 @@ mod common;
 
 use common::gpu;
 
+use cumulus::endless::{Database, Player};
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::Camera;
+use cumulus::render::cpu::renderer::to_srgb8;
 use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::cpu::sky::sun_direction;
 use cumulus::render::cpu::spheroids::{LightGrid, render_spheroids_srgb8};
+use cumulus::render::cpu::volume::render_volume;
 use cumulus::render::gpu::Headless;
 use cumulus::render::gpu::headless::TARGET_FORMAT;
 use cumulus::render::gpu::spheroids::SpheroidRenderer;
+use cumulus::render::gpu::volume_pass::VolumeRenderer;
 use cumulus::report::gpu_bench::FEATURES;
 use cumulus::scene::Scene;
 use cumulus::sim::ProjectedField;
@@ -125,15 +129,21 @@ fn bench_quick_writes_well_formed_results() {
         }
         let grid: f64 = rec[10].parse().unwrap();
         assert_eq!(grid > 0.0, &rec[1] == "spheroids", "{rec:?}");
+        let bytes: usize = rec[11].parse().unwrap();
+        assert!(bytes > 0, "{rec:?}");
     }
     assert_eq!(
         methods,
         [
             "parcels+cloud_map",
             "parcels+spheroids",
-            "automaton+cloud_map"
+            "automaton+cloud_map",
+            "endless+volume"
         ]
     );
+    // The endless playback against its temperature: one row each.
+    let mut r = csv::Reader::from_path(dir.path().join("endless_threshold.csv")).unwrap();
+    assert_eq!(r.records().count(), 6);
 
     let mut r = csv::Reader::from_path(dir.path().join("render_error.csv")).unwrap();
     let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
@@ -321,6 +331,59 @@ fn the_spheroid_renderer_matches_its_cpu_twin() {
     assert!(cloudy > (w * h / 20) as usize, "{cloudy} cloud pixels");
     // Measured on lavapipe: 0.08 levels, every channel within 3 (an
     // aerial perspective applied the wrong way round on the CPU gave 1.4).
+    assert!(mean < 0.4, "mean difference {mean} levels");
+    assert!(within > 0.999, "{within} of channels within 3 levels");
+}
+
+#[test]
+fn the_volume_renderer_matches_its_cpu_twin_on_a_blend() {
+    let Some(ctx) = gpu() else { return };
+    let mut sc = Scene::load(std::path::Path::new("scenes/endless.toml")).unwrap();
+    sc.render.time_s = 600.0;
+    let (w, h) = (96, 64);
+    sc.render.width = w;
+    sc.render.height = h;
+    let mut cfg = sc.simulation.endless.clone();
+    cfg.volumes = 3;
+    cfg.cells = [48, 12, 48];
+    let db = Database::build(&sc, &cfg, || {}).unwrap();
+    assert_eq!(db.len(), 3);
+    assert!(db.d(0, 1) > 0.0, "the clouds moved between volumes");
+    let mut player = Player::new(&db, cfg.similarity, 1);
+    // Halfway through the first interval: two volumes blended.
+    let (stack, params) = db.stack(player.at(0.5 * db.interval_s, db.interval_s));
+    let mut bare = sc.clone();
+    bare.render.time_s = 0.0;
+    let p = Prepared::from_scene(&bare, || {}).unwrap();
+    let r = &sc.render;
+    let settings = p.gpu_settings(r, r.quality());
+    let mut v = VolumeRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        TARGET_FORMAT,
+        &settings,
+        &stack,
+        params,
+    )
+    .unwrap();
+    let gpu = v.read_rgb8(&ctx, &r.camera(), w, h).unwrap();
+    let frame = p.frame(r, r.quality());
+    let cpu = to_srgb8(&render_volume(w, h, &frame, &params, &stack, 1), r.exposure);
+    let diff: Vec<u32> = gpu
+        .iter()
+        .zip(&cpu)
+        .map(|(a, b)| a.abs_diff(*b) as u32)
+        .collect();
+    let mean = diff.iter().sum::<u32>() as f64 / diff.len() as f64;
+    let within = diff.iter().filter(|d| **d <= 3).count() as f64 / diff.len() as f64;
+    let mut empty = stack.clone();
+    empty.texels.fill(0);
+    let clear = to_srgb8(&render_volume(w, h, &frame, &params, &empty, 1), r.exposure);
+    let cloudy = mask(&cpu, &clear).iter().filter(|x| **x).count();
+    eprintln!(
+        "volumes GPU against CPU: mean {mean:.3} levels, {within:.4} within 3; {cloudy} cloud pixels"
+    );
+    assert!(cloudy > (w * h / 20) as usize, "{cloudy} cloud pixels");
     assert!(mean < 0.4, "mean difference {mean} levels");
     assert!(within > 0.999, "{within} of channels within 3 levels");
 }

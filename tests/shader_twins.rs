@@ -46,6 +46,10 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("MAX_CANDIDATES", spheroids::MAX_CANDIDATES as f64),
         ("FBM_OCTAVES", spheroids::FBM_OCTAVES as f64),
         ("FBM_CONTRAST", spheroids::FBM_CONTRAST as f64),
+        (
+            "VOLUME_SHADOW_STEPS",
+            cumulus::render::cpu::volume::VOLUME_SHADOW_STEPS as f64,
+        ),
         ("BASE_RAMP", density::BASE_RAMP as f64),
         ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
@@ -248,6 +252,9 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
     same_layout("Frame", &rust, size_of::<FrameUniforms>());
     let rust = offsets!(Spheroid: centre_radius, shape);
     same_layout("Spheroid", &rust, size_of::<Spheroid>());
+    use cumulus::render::cpu::volume::VolumeParams;
+    let rust = offsets!(VolumeParams: origin, extent, dims, pick);
+    same_layout("VolumeParams", &rust, size_of::<VolumeParams>());
 }
 
 #[test]

@@ -20,7 +20,7 @@ pub use locate::locate_key;
 use locate::{key_at_line, line_col};
 pub use projection::ProjectionSection;
 pub use render::{RenderMethod, RenderSettings};
-pub use simulation::{Method, SimulationSection};
+pub use simulation::{EndlessConfig, Method, SimulationSection};
 
 use crate::sim::lift::surface_lcl_height;
 use crate::sim::{Atmosphere, Band, PhysicsConfig, Sounding, SoundingError};
@@ -160,14 +160,16 @@ impl Scene {
             self.projection.band_checks(),
             self.atmosphere.profile_checks(),
         ];
-        if self.simulation.method == Method::Automaton
+        if self.simulation.method != Method::Parcels
             && self.render.renderer == RenderMethod::Spheroids
         {
             return Err(self.invalid(
                 "render.renderer",
-                "is \"spheroids\", which draws parcels, but simulation.method = \"automaton\" \
-                 has none: use \"cloud_map\""
-                    .into(),
+                format!(
+                    "is \"spheroids\", which draws parcels, but simulation.method = \"{}\" \
+                     has none to draw: use \"cloud_map\"",
+                    self.simulation.method.name()
+                ),
             ));
         }
         match checks.into_iter().flatten().find(|c| !c.ok) {

@@ -1,6 +1,8 @@
 //! `[simulation]`: which method animates the clouds. The parcels (the
 //! cloud-map paper's physics, `[physics]`) are the default; the cellular
-//! automaton (`sim::automaton`, `[simulation.automaton]`) is the other.
+//! automaton (`sim::automaton`, `[simulation.automaton]`) and the endless
+//! playback of precomputed volumes (`crate::endless`,
+//! `[simulation.endless]`) are the others.
 
 use serde::{Deserialize, Serialize};
 
@@ -16,6 +18,9 @@ pub enum Method {
     Parcels,
     /// Dobashi's cellular automaton (after Qin & Lv), projected into P.
     Automaton,
+    /// The parcels simulated ahead into a database of density volumes,
+    /// played back endlessly (Iwasaki, Nishino & Dobashi 2011).
+    Endless,
 }
 
 impl Method {
@@ -24,6 +29,7 @@ impl Method {
         match self {
             Method::Parcels => "parcels",
             Method::Automaton => "automaton",
+            Method::Endless => "endless",
         }
     }
 }
@@ -32,15 +38,85 @@ impl Method {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimulationSection {
-    /// `"parcels"` (default) or `"automaton"`.
+    /// `"parcels"` (default), `"automaton"` or `"endless"`.
     pub method: Method,
     /// The automaton's settings (read only by `method = "automaton"`).
     pub automaton: AutomatonConfig,
+    /// The volume database's settings (read only by `method = "endless"`).
+    pub endless: EndlessConfig,
+}
+
+/// `[simulation.endless]`: the database of volumes and its playback.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EndlessConfig {
+    /// Volumes in the database (2..=256). Default 24.
+    pub volumes: usize,
+    /// Seconds of sky between stored volumes (1..=600); playback blends
+    /// between them. Default 30.
+    pub interval_s: f64,
+    /// Voxels of each volume along x, y (up) and z (each 2..=512, and
+    /// `y · volumes` at most 2048: they are stacked in one 3D texture).
+    /// Default `[192, 32, 192]`.
+    pub cells: [u32; 3],
+    /// The transition temperature σ as a multiple of the mean distance
+    /// between consecutive volumes (> 0): small, only near-identical
+    /// volumes follow each other (few jumps, short loops); large, any
+    /// volume may follow any (visible jumps). Default 0.5.
+    pub similarity: f64,
+}
+
+impl Default for EndlessConfig {
+    fn default() -> Self {
+        Self {
+            volumes: 24,
+            interval_s: 30.0,
+            cells: [192, 32, 192],
+            similarity: 0.5,
+        }
+    }
+}
+
+impl EndlessConfig {
+    /// Every field against its domain.
+    pub fn checks(&self) -> Vec<Check> {
+        let [x, y, z] = self.cells;
+        vec![
+            Check::new(
+                "simulation.endless.volumes",
+                (2..=256).contains(&self.volumes),
+                "2..=256 volumes",
+                self.volumes as f64,
+            ),
+            Check::range(
+                "simulation.endless.interval_s",
+                self.interval_s,
+                1.0,
+                600.0,
+                "1..=600 s",
+            ),
+            Check::new(
+                "simulation.endless.cells",
+                [x, y, z].iter().all(|n| (2..=512).contains(n))
+                    && y as usize * self.volumes <= 2048,
+                "2..=512 voxels each, with cells[1] * volumes <= 2048",
+                (x as f64) * (y as f64) * (z as f64),
+            ),
+            Check::new(
+                "simulation.endless.similarity",
+                self.similarity.is_finite() && self.similarity > 0.0,
+                "a multiple > 0",
+                self.similarity,
+            ),
+        ]
+    }
 }
 
 impl SimulationSection {
     /// Every key against its domain.
     pub fn checks(&self) -> Vec<Check> {
-        self.automaton.checks("simulation.automaton")
+        let mut c = self.automaton.checks("simulation.automaton");
+        c.extend(self.endless.checks());
+        c
     }
 }

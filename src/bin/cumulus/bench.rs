@@ -76,6 +76,13 @@ pub fn run(a: BenchArgs) -> Result<()> {
             m.light_grid_ms
         );
     }
+    println!("endless playback against its similarity temperature (sigma / mean step):");
+    for t in &report.endless {
+        println!(
+            "  {:>5}: {:.1} jumps per 100 steps, a jump {:.2}x (largest {:.2}x) a plain step's change; {} volumes shown, {} in the second half",
+            t.similarity, t.jumps_per_100, t.mean_jump, t.max_jump, t.distinct, t.distinct_late
+        );
+    }
     println!("wrote {}", a.out.display());
     Ok(())
 }

@@ -9,7 +9,7 @@ use cumulus::io::write_png_atomically;
 use cumulus::prepare::Prepared;
 use cumulus::render::gpu::GpuContext;
 use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
-use cumulus::scene::{RenderMethod, Scene};
+use cumulus::scene::{Method, RenderMethod, Scene};
 
 use crate::{
     check_output_file, gpu_context, guard_output_dir, guard_output_file, load_scene, progress_bar,
@@ -149,6 +149,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     if gpu.is_none() && a.time_frames.is_some() {
         bail!("--time-frames needs the GPU backend (--backend gpu)");
+    }
+    if scene.simulation.method == Method::Endless {
+        return render_endless(gpu.as_ref(), &a, &scene, picture);
     }
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
@@ -381,6 +384,100 @@ fn render_spheroids(
         r.height,
         spheroids.len(),
         start.elapsed().as_secs_f64(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// `render` with `[simulation] method = "endless"`: the database built,
+/// the first moment of its playback drawn by the volume renderer on the
+/// GPU, or by its CPU twin.
+fn render_endless(
+    gpu: Option<&GpuContext>,
+    a: &RenderArgs,
+    scene: &Scene,
+    picture: Option<Picture>,
+) -> Result<()> {
+    use cumulus::endless::{Database, Player};
+    use cumulus::render::cpu::renderer::to_srgb8;
+    use cumulus::render::cpu::volume::render_volume;
+    use cumulus::render::gpu::volume_pass::VolumeRenderer;
+
+    let r = &scene.render;
+    let cfg = &scene.simulation.endless;
+    if a.time_frames.is_some() || a.quality_report.is_some() {
+        bail!(
+            "--time-frames and --quality-report are for the cloud map; `cumulus bench --methods` times the volumes"
+        );
+    }
+    let frames = Prepared::frames(scene)
+        + (cfg.volumes.saturating_sub(1) as f64 * cfg.interval_s / scene.physics.dt_s).ceil()
+            as u64;
+    let bar = progress_bar(frames, "simulating and sampling the volumes");
+    let db = Database::build(scene, cfg, || bar.inc(1))?;
+    bar.finish_and_clear();
+    eprintln!(
+        "database: {} volumes of {}x{}x{} ({:.1} MB) built in {:.1} s",
+        db.len(),
+        db.dims[0],
+        db.dims[1],
+        db.dims[2],
+        db.bytes() as f64 / 1e6,
+        db.build_s
+    );
+    let Some(out) = &a.out else { return Ok(()) };
+    let mut player = Player::new(&db, cfg.similarity, scene.physics.seed);
+    let (stack, params) = db.stack(player.at(0.0, db.interval_s));
+    let rgb8 = match gpu {
+        Some(ctx) => {
+            if picture == Some(Picture::Exr) {
+                bail!(
+                    "{}: the volume renderer writes PNG on the GPU; use --backend cpu for OpenEXR",
+                    out.display()
+                );
+            }
+            eprintln!("backend: gpu ({})", ctx.describe());
+            let settings = r.gpu_settings_at(
+                cumulus::sim::Band {
+                    bottom_m: db.origin.y as f64,
+                    top_m: (db.origin.y + db.extent.y) as f64,
+                },
+                db.extent.x as f64,
+                r.quality(),
+            );
+            let mut v = VolumeRenderer::new(
+                &ctx.device,
+                &ctx.queue,
+                TARGET_FORMAT,
+                &settings,
+                &stack,
+                params,
+            )?;
+            v.read_rgb8(ctx, &r.camera(), r.width, r.height)?
+        }
+        None => {
+            let mut bare = scene.clone();
+            bare.simulation.method = Method::Parcels;
+            bare.render.time_s = 0.0;
+            let p = Prepared::from_scene(&bare, || {})?;
+            let frame = p.frame(r, r.quality());
+            let linear = render_volume(r.width, r.height, &frame, &params, &stack, r.cpu_offsets);
+            if picture == Some(Picture::Exr) {
+                let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
+                write_exr(out, r.width, r.height, rgb)?;
+                eprintln!("wrote {}", out.display());
+                return Ok(());
+            }
+            to_srgb8(&linear, r.exposure)
+        }
+    };
+    let img = image::RgbImage::from_raw(r.width, r.height, rgb8).context("image buffer size")?;
+    write_png_atomically(out, &img)
+        .with_context(|| format!("{}: cannot write image", out.display()))?;
+    eprintln!(
+        "rendered {}x{} from the volumes; wrote {}",
+        r.width,
+        r.height,
         out.display()
     );
     Ok(())

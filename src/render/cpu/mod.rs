@@ -14,3 +14,4 @@ pub mod sky;
 pub mod sky_luts;
 pub mod spheroids;
 pub mod tone_map;
+pub mod volume;

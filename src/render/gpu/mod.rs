@@ -13,11 +13,13 @@ pub mod settings;
 pub mod shaders;
 pub mod sky_luts_pass;
 pub mod spheroids;
+mod standalone;
 mod terrain_pass;
 pub mod textures;
 pub mod timer;
 pub mod tsaa;
 pub mod uniforms;
+pub mod volume_pass;
 
 pub use composite_pass::is_hdr;
 pub use context::{GpuContext, GpuError};

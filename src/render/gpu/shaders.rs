@@ -120,6 +120,16 @@ pub fn spheroids_pass() -> String {
     )
 }
 
+/// The volume renderer's source (bind group 0 the uniforms alone: the
+/// analytic sky).
+pub fn volume_pass() -> String {
+    format!(
+        "{}{COMPOSITE}\n{}",
+        shared(false),
+        super::volume_pass::VOLUME
+    )
+}
+
 /// The sky tables' source: three compute entry points.
 pub fn sky_luts_pass() -> String {
     format!("{SKY_LUTS}\n{SKY_LUTS_BUILD}")
@@ -127,9 +137,14 @@ pub fn sky_luts_pass() -> String {
 
 /// Every variant's source: under each sky model, the cloud pass with and
 /// without depth and TSAA, the composite pass over each background and
-/// the terrain; TSAA, the spheroids and the sky tables.
+/// the terrain; TSAA, the spheroids, the volumes and the sky tables.
 pub fn all_variants() -> Vec<String> {
-    let mut sources = vec![tsaa_pass(), spheroids_pass(), sky_luts_pass()];
+    let mut sources = vec![
+        tsaa_pass(),
+        spheroids_pass(),
+        volume_pass(),
+        sky_luts_pass(),
+    ];
     for physical in [false, true] {
         sources.push(terrain_pass(physical));
         for depth in [false, true] {

@@ -9,7 +9,6 @@
 
 use super::bind::{self, Recorder};
 use super::settings::GpuSettings;
-use super::uniforms::{FrameInputs, FrameUniforms};
 use crate::render::camera::Camera;
 
 use crate::render::cpu::sky::sun_direction;
@@ -62,12 +61,7 @@ impl SpheroidRenderer {
             &[uniforms.as_entire_binding()],
         );
         let module = bind::module(device, "spheroids", super::shaders::spheroids_pass());
-        let mut constants = settings.constants();
-        constants.push(("ENCODE_SRGB", (!format.is_srgb()) as u8 as f64));
-        constants.push((
-            "TONE_MAP",
-            (!super::composite_pass::is_hdr(format)) as u8 as f64,
-        ));
+        let constants = super::standalone::constants(settings, format);
         let pipeline = bind::full_screen_pipeline(
             device,
             "spheroids",
@@ -187,25 +181,7 @@ impl SpheroidRenderer {
         if self.width == 0 || self.height == 0 {
             return;
         }
-        let aspect = self.width as f32 / self.height as f32;
-        let u = FrameUniforms::new(&FrameInputs {
-            view: camera.view(aspect, self.settings.quality.max_distance_m),
-            depth_flipped: false,
-            prev_view_proj: glam::Mat4::IDENTITY,
-            width: self.width,
-            height: self.height,
-            sun_elevation_deg: self.settings.sun_elevation_deg,
-            sun_azimuth_deg: self.settings.sun_azimuth_deg,
-            density: self.settings.density,
-            quality: self.settings.quality,
-            jitter: [0.0; 3],
-            blend: 1.0,
-            frame_index: 0,
-            terrain: [0.0; 2],
-            p_size: [1, 1],
-            mask: [1, 1, 1, 0],
-            map_size: 1,
-        });
+        let u = super::standalone::uniforms(&self.settings, camera, self.width, self.height);
         self.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         let mut rec = Recorder::new(encoder, timestamps);
@@ -232,30 +208,10 @@ impl SpheroidRenderer {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, super::GpuError> {
-        use wgpu::TextureFormat::{Rgba8Unorm, Rgba8UnormSrgb};
-        if !matches!(self.format, Rgba8Unorm | Rgba8UnormSrgb) {
-            return Err(super::GpuError::Readback(format!(
-                "the spheroid renderer reads back RGBA8 targets, not {:?}",
-                self.format
-            )));
-        }
         self.resize(width, height);
-        let target = super::textures::create_2d(
-            &ctx.device,
-            "spheroids.target",
-            width,
-            height,
-            self.format,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
-        let view = target.create_view(&Default::default());
-        let mut e = ctx.device.create_command_encoder(&Default::default());
-        self.render(&mut e, &view, camera, None);
-        ctx.queue.submit([e.finish()]);
-        let px = ctx.read_texture(&target, 4)?;
-        Ok(px
-            .chunks_exact(4)
-            .flat_map(|q| [q[0], q[1], q[2]])
-            .collect())
+        let format = self.format;
+        super::standalone::read_rgb8(ctx, format, width, height, |e, view| {
+            self.render(e, view, camera, None)
+        })
     }
 }

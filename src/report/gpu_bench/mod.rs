@@ -117,9 +117,9 @@ pub struct PhysicsRow {
 /// (spheroids) its light grid's build.
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodRow {
-    /// The animation: "parcels" or "automaton".
+    /// The animation: "parcels", "automaton" or "endless".
     pub method: &'static str,
-    /// The renderer: "cloud_map" or "spheroids".
+    /// The renderer: "cloud_map", "spheroids" or "volume".
     pub renderer: &'static str,
     pub width: u32,
     pub height: u32,
@@ -134,6 +134,10 @@ pub struct MethodRow {
     pub step_s: f64,
     /// The light grid's CPU build (spheroids only), ms.
     pub light_grid_ms: f64,
+    /// What the frame keeps on the GPU of the animation's state, bytes:
+    /// P (half floats), the spheroids and their light grid, or every
+    /// volume of the database.
+    pub state_bytes: usize,
 }
 
 /// Rendering error against run time: one knob varied, the others at the
@@ -163,6 +167,8 @@ pub struct Report {
     pub physics: Vec<PhysicsRow>,
     /// The methods side by side ([`MethodRow`]).
     pub methods: Vec<MethodRow>,
+    /// The endless playback's jumps against its similarity temperature.
+    pub endless: Vec<crate::endless::ThresholdRow>,
     pub quality: Vec<QualityRow>,
     /// Quality images' size.
     pub quality_size: [u32; 2],
@@ -242,7 +248,7 @@ pub fn run(
     };
     if o.methods_only {
         let methods = compare_methods(ctx, &base, o, &mut progress)?;
-        let timing = methods.first().map_or("wall", |m| m.timing);
+        let timing = methods.0.first().map_or("wall", |m| m.timing);
         return Ok(report(
             ctx,
             o,
@@ -360,7 +366,7 @@ fn report(
     timing: &'static str,
     rows: Vec<Row>,
     physics: Vec<PhysicsRow>,
-    methods: Vec<MethodRow>,
+    (methods, endless): (Vec<MethodRow>, Vec<crate::endless::ThresholdRow>),
     (quality, quality_size): (Vec<QualityRow>, [u32; 2]),
 ) -> Report {
     let i = &ctx.adapter_info;
@@ -375,6 +381,7 @@ fn report(
         rows,
         physics,
         methods,
+        endless,
         quality,
         quality_size,
     }

@@ -73,6 +73,41 @@ pub(super) fn time_spheroids(
     })
 }
 
+/// Times the volume renderer of `stack` with `r`.
+pub(super) fn time_volume(
+    ctx: &GpuContext,
+    p: &Prepared,
+    r: &RenderSettings,
+    o: &BenchOptions,
+    stack: &crate::render::cpu::volume::VolumeStack,
+    params: crate::render::cpu::volume::VolumeParams,
+) -> Result<FrameTimes, GpuError> {
+    let settings = p.gpu_settings(r, r.quality());
+    let mut v = crate::render::gpu::volume_pass::VolumeRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        TARGET_FORMAT,
+        &settings,
+        stack,
+        params,
+    )?;
+    v.resize(r.width, r.height);
+    let target = textures::create_2d(
+        &ctx.device,
+        "bench.target",
+        r.width,
+        r.height,
+        TARGET_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let view = target.create_view(&Default::default());
+    let camera = r.camera();
+    time_frames(ctx, o.warmup, o.frames, |enc, q| {
+        v.render(enc, &view, &camera, q);
+        Ok(1)
+    })
+}
+
 pub(super) fn row(
     group: &'static str,
     renderer: &'static str,

@@ -7,7 +7,7 @@ use crate::io::write_atomically;
 use crate::report::ReportError;
 use crate::report::plot::{Series, bars_png, loglog_png};
 
-/// Writes `bench.csv`, `physics_in_frame.csv`, `methods.csv`, `render_error.csv`,
+/// Writes `bench.csv`, `physics_in_frame.csv`, `methods.csv`, `endless_threshold.csv`, `render_error.csv`,
 /// `bench.json` and the plots into `dir`.
 pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     let path = dir.join("bench.csv");
@@ -41,12 +41,34 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     .map_err(ReportError::writing(&path))?;
     let path = dir.join("methods.csv");
     write_atomically(&path, |out| {
-        writeln!(out, "method,renderer,width,height,p_covered,median_ms,p95_ms,timing,step_ms,step_s,light_grid_ms")?;
+        writeln!(out, "method,renderer,width,height,p_covered,median_ms,p95_ms,timing,step_ms,step_s,light_grid_ms,state_bytes")?;
         for r in &report.methods {
             writeln!(
                 out,
-                "{},{},{},{},{:.4},{:.4},{:.4},{},{:.4},{},{:.3}",
-                r.method, r.renderer, r.width, r.height, r.p_covered, r.median_ms, r.p95_ms, r.timing, r.step_ms, r.step_s, r.light_grid_ms
+                "{},{},{},{},{:.4},{:.4},{:.4},{},{:.7},{},{:.3},{}",
+                r.method, r.renderer, r.width, r.height, r.p_covered, r.median_ms, r.p95_ms, r.timing, r.step_ms, r.step_s, r.light_grid_ms, r.state_bytes
+            )?;
+        }
+        Ok(())
+    })
+    .map_err(ReportError::writing(&path))?;
+    let path = dir.join("endless_threshold.csv");
+    write_atomically(&path, |out| {
+        writeln!(
+            out,
+            "similarity,steps,jumps_per_100,mean_jump,max_jump,distinct,distinct_late"
+        )?;
+        for r in &report.endless {
+            writeln!(
+                out,
+                "{},{},{:.2},{:.4},{:.4},{},{}",
+                r.similarity,
+                r.steps,
+                r.jumps_per_100,
+                r.mean_jump,
+                r.max_jump,
+                r.distinct,
+                r.distinct_late
             )?;
         }
         Ok(())

@@ -1,0 +1,143 @@
+// The volume renderer (after Iwasaki, Nishino & Dobashi 2011): clouds
+// played back from precomputed density volumes, all in one 3D texture of
+// 8-bit densities stacked along y; each frame blends two of them (the
+// cross-dissolve) and marches the band. `[simulation] method = "endless"`
+// draws a scene with it. The CPU twin is src/render/cpu/volume.rs. The
+// sky, haze and tone map are the cloud pass's own functions. Appended to
+// clouds.wgsl and composite.wgsl.
+
+// Keep in sync with src/render/cpu/volume.rs: VolumeParams.
+struct VolumeParams {
+    origin: vec4f, // the box's lowest corner (m)
+    extent: vec4f, // the box's size (m); extinction of a full texel (1/m)
+    dims: vec4u,   // voxels of one volume along x, y, z; volumes stacked
+    pick: vec4f,   // the two volumes shown, the second's weight
+}
+
+@group(1) @binding(0) var volumes: texture_3d<f32>;
+@group(1) @binding(1) var<uniform> volume: VolumeParams;
+
+// Samples of a lit sample's shadow march towards the sun.
+const VOLUME_SHADOW_STEPS: u32 = 6u;
+
+fn volume_texel(x: i32, y: i32, z: i32) -> f32 {
+    return textureLoad(volumes, vec3i(x, y, z), 0).r;
+}
+
+// Volume `slab`'s density at p in 0..1: trilinear between voxel centres,
+// periodic across, 0 past the band's ends.
+fn volume_sample(p: vec3f, slab: f32) -> f32 {
+    let dims = vec3f(volume.dims.xyz);
+    let g = (p - volume.origin.xyz) / volume.extent.xyz * dims - vec3f(0.5);
+    if g.y < -1.0 || g.y > dims.y {
+        return 0.0;
+    }
+    let f = floor(g);
+    let t = g - f;
+    let nx = i32(volume.dims.x);
+    let ny = i32(volume.dims.y);
+    let nz = i32(volume.dims.z);
+    let base = i32(slab) * ny;
+    let x0 = wrap_i(i32(f.x), nx);
+    let x1 = (x0 + 1) % nx;
+    let z0 = wrap_i(i32(f.z), nz);
+    let z1 = (z0 + 1) % nz;
+    let y0 = i32(f.y);
+    let y1 = y0 + 1;
+    var a = vec4f(0.0); // rows y0: (x0,z0), (x1,z0), (x0,z1), (x1,z1)
+    var b = vec4f(0.0); // rows y1
+    if y0 >= 0 && y0 < ny {
+        a = vec4f(volume_texel(x0, base + y0, z0), volume_texel(x1, base + y0, z0),
+            volume_texel(x0, base + y0, z1), volume_texel(x1, base + y0, z1));
+    }
+    if y1 >= 0 && y1 < ny {
+        b = vec4f(volume_texel(x0, base + y1, z0), volume_texel(x1, base + y1, z0),
+            volume_texel(x0, base + y1, z1), volume_texel(x1, base + y1, z1));
+    }
+    let x00 = mix(a.x, a.y, t.x);
+    let x10 = mix(b.x, b.y, t.x);
+    let x01 = mix(a.z, a.w, t.x);
+    let x11 = mix(b.z, b.w, t.x);
+    return mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z);
+}
+
+// Extinction (1/m) at p: the two picked volumes blended.
+fn volume_density(p: vec3f) -> f32 {
+    let a = volume_sample(p, volume.pick.x);
+    let b = volume_sample(p, volume.pick.y);
+    return volume.extent.w * mix(a, b, volume.pick.z);
+}
+
+// The sun's optical depth from p: even steps along the shadow ray.
+fn volume_optical_depth(p: vec3f, sun_dir: vec3f, length: f32) -> f32 {
+    let dt = length / f32(VOLUME_SHADOW_STEPS);
+    var tau = 0.0;
+    for (var i = 0u; i < VOLUME_SHADOW_STEPS; i++) {
+        tau += volume_density(p + sun_dir * ((f32(i) + 0.5) * dt)) * dt;
+    }
+    return tau;
+}
+
+// The band's march with steps growing with distance (`march_distance`),
+// one density read per step, a shadow march per lit step.
+fn march_volume(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
+    let seg = band_segment(origin, dir, frame.band.x, frame.band.y, frame.sun_light.w);
+    if seg.y <= seg.x {
+        return vec4f(0.0);
+    }
+    let t0 = seg.x;
+    let sun_dir = frame.sun_dir.xyz;
+    let steps = max(frame.counts.x, 1u);
+    let log_ratio = log((seg.y + NEAR_M) / (t0 + NEAR_M));
+    let cos_theta = dot(dir, sun_dir);
+    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
+    let sky_top = sky_ambient(sun_dir) * 0.25;
+    let ground = ground_up(sun_dir, SEA) * 0.25;
+    var transmittance = 1.0;
+    var light = vec3f(0.0);
+    var depth_weighted = 0.0;
+    for (var i = 0u; i < steps; i++) {
+        let ta = march_distance(t0, log_ratio, f32(i) / f32(steps));
+        let tb = march_distance(t0, log_ratio, f32(i + 1u) / f32(steps));
+        let t = ta + dither * (tb - ta);
+        let dt = tb - ta;
+        let p = origin + dir * t;
+        let sigma_t = volume_density(p);
+        if sigma_t <= 0.0 {
+            continue;
+        }
+        let tau_sun = volume_optical_depth(p, sun_dir, shadow_ray_length(p, sun_dir));
+        let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
+        let ambient = ambient_light(sky_top, ground, eta);
+        let src = (sun * sun_scattering(tau_sun, cos_theta, sun_dir.y) + ambient) * (sigma_t * ALBEDO);
+        let step_t = exp(-sigma_t * dt);
+        light += integrate_step(src, sigma_t, dt) * transmittance;
+        depth_weighted += t * transmittance * (1.0 - step_t);
+        transmittance *= step_t;
+        if transmittance < MIN_TRANSMITTANCE {
+            break;
+        }
+    }
+    let opacity = 1.0 - transmittance;
+    var distance = 0.0;
+    if opacity > 0.0 {
+        distance = depth_weighted / opacity;
+    }
+    let a = aerial(dir, distance, sun_dir);
+    return vec4f(light * a.transmittance + a.inscatter * opacity, opacity);
+}
+
+// The per-pixel dither: the spheroid renderer's (interleaved gradient
+// noise), so the pass needs no blue-noise texture.
+fn spheroid_dither(x: u32, y: u32) -> f32 {
+    return fract(52.982918 * fract(0.06711056 * f32(x) + 0.00583715 * f32(y)));
+}
+
+@fragment
+fn fs_volume(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let px = vec2u(pos.xy);
+    let dir = camera_ray(pos.xy);
+    let c = march_volume(frame.cam_pos.xyz, dir, spheroid_dither(px.x, px.y));
+    let bg = background_radiance(dir, frame.sun_dir.xyz, 1.0, vec4f(0.0, 0.0, 0.0, 1.0));
+    return vec4f(display(c.rgb + (1.0 - c.a) * bg), 1.0);
+}

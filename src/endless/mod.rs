@@ -1,0 +1,177 @@
+//! Endless animation from precomputed volumes (Iwasaki, Nishino & Dobashi
+//! 2011, papers 000 and 002): the scene's parcels are simulated ahead and
+//! the density the cloud-map renderer marches is sampled into a database
+//! of volumes `interval_s` apart (`report::volume_export::sample`, the
+//! volume export's own sampler); the distance between every two volumes
+//! is measured; at run time [`Player`] plays an endless sequence, jumping
+//! from volume `k` to a volume like `k + 1` (the Video Textures idea) and
+//! blending each pair of neighbours in the sequence over one interval
+//! (the cross-dissolve). `render::gpu::volume_pass` draws it from one 3D
+//! texture holding every volume; `render::cpu::volume` is its twin.
+//! `[simulation] method = "endless"` chooses it; docs/methods.md
+//! compares it with live physics.
+
+mod player;
+
+use glam::Vec3;
+
+pub use player::{Player, ThresholdRow, threshold_sweep};
+
+use crate::prepare::Prepared;
+use crate::render::cpu::volume::{VolumeParams, VolumeStack};
+use crate::report::volume_export::{Grid, sample};
+use crate::scene::{EndlessConfig, Scene, SceneError};
+
+/// The database: the volumes, their distances, and where they lie.
+#[derive(Debug, Clone)]
+pub struct Database {
+    /// Voxels of one volume along x, y (up), z.
+    pub dims: [usize; 3],
+    /// Each volume's densities as bytes (`σ / extinction · 255`), x
+    /// fastest, then y, then z.
+    pub volumes: Vec<Vec<u8>>,
+    /// `distance[k * n + l]`: the summed squared difference of volumes
+    /// `k` and `l` (densities in 0..1), the paper's `D_kl`.
+    pub distance: Vec<f64>,
+    /// Sky seconds between stored volumes.
+    pub interval_s: f64,
+    /// The box: lowest corner and size, m.
+    pub origin: Vec3,
+    pub extent: Vec3,
+    /// Extinction of a full byte, 1/m.
+    pub extinction_per_m: f32,
+    /// CPU wall time of the build, s (simulation and sampling).
+    pub build_s: f64,
+}
+
+impl Database {
+    /// Simulates `scene` and samples `cfg.volumes` volumes over its
+    /// domain and band (`progress` after each physics frame and volume).
+    pub fn build(
+        scene: &Scene,
+        cfg: &EndlessConfig,
+        mut progress: impl FnMut(),
+    ) -> Result<Self, SceneError> {
+        let start = std::time::Instant::now();
+        let r = &scene.render;
+        let mut volumes = Vec::with_capacity(cfg.volumes);
+        let mut placed: Option<(Vec3, Vec3, f32)> = None;
+        let [nx, ny, nz] = cfg.cells;
+        let mut grid_error = None;
+        let mut progress_cell = || progress();
+        Prepared::snapshots(
+            scene,
+            cfg.interval_s,
+            cfg.volumes,
+            |_, p| {
+                let l = p.map_extent_m as f32;
+                let min = Vec3::new(0.0, p.band.bottom_m as f32, 0.0);
+                let max = Vec3::new(l, p.band.top_m as f32, l);
+                let grid = match Grid::new([nx, ny, nz], min, max) {
+                    Ok(g) => g,
+                    Err(e) => {
+                        grid_error = Some(e.to_string());
+                        return;
+                    }
+                };
+                let frame = p.frame(r, r.quality());
+                let full = frame.density.extinction_per_m.max(1e-9);
+                let values = sample(&frame, &grid);
+                volumes.push(
+                    values
+                        .iter()
+                        .map(|v| (v / full * 255.0).round().clamp(0.0, 255.0) as u8)
+                        .collect::<Vec<u8>>(),
+                );
+                placed = Some((min, max - min, full));
+            },
+            &mut progress_cell,
+        )?;
+        if let Some(e) = grid_error {
+            return Err(scene.invalid("simulation.endless.cells", e));
+        }
+        let (origin, extent, full) = placed.unwrap_or((Vec3::ZERO, Vec3::ONE, 0.0));
+        let distance = distances(&volumes);
+        Ok(Self {
+            dims: [nx as usize, ny as usize, nz as usize],
+            volumes,
+            distance,
+            interval_s: cfg.interval_s,
+            origin,
+            extent,
+            extinction_per_m: full,
+            build_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Volumes stored.
+    pub fn len(&self) -> usize {
+        self.volumes.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.volumes.is_empty()
+    }
+
+    /// Bytes of the volumes (what the GPU keeps resident).
+    pub fn bytes(&self) -> usize {
+        self.volumes.iter().map(Vec::len).sum()
+    }
+
+    /// The distance `D_kl`.
+    pub fn d(&self, k: usize, l: usize) -> f64 {
+        self.distance[k * self.len() + l]
+    }
+
+    /// The mean distance between consecutive volumes (the step that
+    /// plain playback makes).
+    pub fn mean_step(&self) -> f64 {
+        let n = self.len();
+        if n < 2 {
+            return 0.0;
+        }
+        (0..n - 1).map(|k| self.d(k, k + 1)).sum::<f64>() / (n - 1) as f64
+    }
+
+    /// The volumes stacked for the 3D texture, and their placement with
+    /// the pair `(a, b, w)` picked.
+    pub fn stack(&self, pick: (usize, usize, f32)) -> (VolumeStack, VolumeParams) {
+        let stack = VolumeStack::new(self.dims, &self.volumes);
+        let [nx, ny, nz] = self.dims;
+        let params = VolumeParams {
+            origin: [self.origin.x, self.origin.y, self.origin.z, 0.0],
+            extent: [
+                self.extent.x,
+                self.extent.y,
+                self.extent.z,
+                self.extinction_per_m,
+            ],
+            dims: [nx as u32, ny as u32, nz as u32, self.len() as u32],
+            pick: [pick.0 as f32, pick.1 as f32, pick.2, 0.0],
+        };
+        (stack, params)
+    }
+}
+
+/// Every pair's summed squared difference (densities as bytes / 255).
+pub fn distances(volumes: &[Vec<u8>]) -> Vec<f64> {
+    use rayon::prelude::*;
+    let n = volumes.len();
+    let mut d = vec![0.0; n * n];
+    d.par_chunks_mut(n.max(1)).enumerate().for_each(|(k, row)| {
+        for (l, out) in row.iter_mut().enumerate() {
+            if l != k {
+                *out = volumes[k]
+                    .iter()
+                    .zip(&volumes[l])
+                    .map(|(a, b)| {
+                        let x = (*a as f64 - *b as f64) / 255.0;
+                        x * x
+                    })
+                    .sum();
+            }
+        }
+    });
+    d
+}

@@ -1,0 +1,340 @@
+//! The volume renderer's CPU twin (WGSL in `shaders/volume.wgsl`, each
+//! function of the same name): clouds played back from precomputed
+//! density volumes (Iwasaki, Nishino & Dobashi 2011; `crate::endless`
+//! builds the database and chooses the pair to show). All the volumes sit
+//! in one 3D texture of 8-bit densities, stacked along `y`; a frame reads
+//! two of them and blends (the cross-dissolve), marching the band with
+//! steps that grow with distance and a short shadow march towards the sun
+//! per lit sample. The volume tiles the plane (it is one periodic domain).
+//! The light is the cloud map's (phase, multiple-scattering octaves,
+//! ambient, aerial perspective), under the analytic sky (the pass binds
+//! no sky tables). Reads are `textureLoad` with the trilinear weights
+//! computed in the shader, so the two twins read the same bytes with the
+//! same arithmetic.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
+
+use super::density::band_segment;
+use super::lighting::{integrate_step, shadow_ray_length, sun_scattering};
+use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, NEAR_M, ambient_light, march_distance};
+use super::sky::{
+    SkyLight, aerial, background_radiance, ground_up, sky_ambient, sun_direction, sun_light_at,
+};
+use super::spheroids::spheroid_dither;
+use crate::render::sampling::frame_offset;
+
+/// Samples of a lit sample's shadow march towards the sun.
+pub const VOLUME_SHADOW_STEPS: u32 = 6;
+
+// Keep in sync with shaders/volume.wgsl: VolumeParams.
+/// Where the volumes lie and which two a frame blends.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct VolumeParams {
+    /// The box's lowest corner (m), 0.
+    pub origin: [f32; 4],
+    /// The box's size (m); the extinction of a full texel (1/m).
+    pub extent: [f32; 4],
+    /// Voxels along x, y, z of one volume; the volumes stacked.
+    pub dims: [u32; 4],
+    /// The two volumes shown and the weight of the second, 0.
+    pub pick: [f32; 4],
+}
+
+const _: () = assert!(size_of::<VolumeParams>() == 64);
+
+/// The volumes as the GPU holds them: one 3D texture `nx x (ny · count)
+/// x nz` of bytes (x fastest, then y, then z).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VolumeStack {
+    /// Voxels of one volume along x, y (up), z.
+    pub dims: [usize; 3],
+    /// Volumes stacked.
+    pub count: usize,
+    /// The bytes, `density / full · 255` rounded.
+    pub texels: Vec<u8>,
+}
+
+impl VolumeStack {
+    /// The stack of `volumes`, each `dims` voxels in x-fastest order
+    /// (x, then y up, then z).
+    pub fn new(dims: [usize; 3], volumes: &[Vec<u8>]) -> Self {
+        let [nx, ny, nz] = dims;
+        let count = volumes.len();
+        let mut texels = vec![0u8; nx * ny * nz * count];
+        for (v, vol) in volumes.iter().enumerate() {
+            for k in 0..nz {
+                for j in 0..ny {
+                    let src = (k * ny + j) * nx;
+                    let dst = (k * ny * count + v * ny + j) * nx;
+                    texels[dst..dst + nx].copy_from_slice(&vol[src..src + nx]);
+                }
+            }
+        }
+        Self {
+            dims,
+            count,
+            texels,
+        }
+    }
+
+    /// The texture's size: x, y (all volumes), z.
+    pub fn texture_size(&self) -> [u32; 3] {
+        [
+            self.dims[0] as u32,
+            (self.dims[1] * self.count) as u32,
+            self.dims[2] as u32,
+        ]
+    }
+}
+
+/// The texel at integer `(x, y, z)` of the stack, in 0..=1 (the WGSL
+/// `textureLoad` of an 8-bit unorm texel).
+#[inline]
+pub fn volume_texel(stack: &VolumeStack, x: i32, y: i32, z: i32) -> f32 {
+    let [nx, ny, _] = stack.dims;
+    let rows = ny * stack.count;
+    stack.texels[(z as usize * rows + y as usize) * nx + x as usize] as f32 / 255.0
+}
+
+/// Volume `slab`'s density at `p` in 0..=1, trilinear between voxel
+/// centres, periodic across, 0 past the band's ends (half a voxel of
+/// fade).
+#[inline]
+pub fn volume_sample(p: Vec3, slab: f32, params: &VolumeParams, stack: &VolumeStack) -> f32 {
+    let dims = Vec3::new(
+        params.dims[0] as f32,
+        params.dims[1] as f32,
+        params.dims[2] as f32,
+    );
+    let origin = Vec3::from_slice(&params.origin[..3]);
+    let extent = Vec3::from_slice(&params.extent[..3]);
+    let g = (p - origin) / extent * dims - 0.5;
+    if g.y < -1.0 || g.y > dims.y {
+        return 0.0;
+    }
+    let f = g.floor();
+    let t = g - f;
+    let (nx, ny, nz) = (
+        params.dims[0] as i32,
+        params.dims[1] as i32,
+        params.dims[2] as i32,
+    );
+    let base = slab as i32 * ny;
+    let x0 = (f.x as i32).rem_euclid(nx);
+    let x1 = (x0 + 1) % nx;
+    let z0 = (f.z as i32).rem_euclid(nz);
+    let z1 = (z0 + 1) % nz;
+    let yi = f.y as i32;
+    let row = |y: i32, x: i32, z: i32| {
+        if y < 0 || y >= ny {
+            0.0
+        } else {
+            volume_texel(stack, x, base + y, z)
+        }
+    };
+    let mix = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let x00 = mix(row(yi, x0, z0), row(yi, x1, z0), t.x);
+    let x10 = mix(row(yi + 1, x0, z0), row(yi + 1, x1, z0), t.x);
+    let x01 = mix(row(yi, x0, z1), row(yi, x1, z1), t.x);
+    let x11 = mix(row(yi + 1, x0, z1), row(yi + 1, x1, z1), t.x);
+    mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z)
+}
+
+/// Extinction (1/m) at `p`: the two picked volumes blended.
+#[inline]
+pub fn volume_density(p: Vec3, params: &VolumeParams, stack: &VolumeStack) -> f32 {
+    let a = volume_sample(p, params.pick[0], params, stack);
+    let b = volume_sample(p, params.pick[1], params, stack);
+    params.extent[3] * (a + (b - a) * params.pick[2])
+}
+
+/// The sun's optical depth from `p`: [`VOLUME_SHADOW_STEPS`] even steps
+/// along the shadow ray (to the band's top, at most `SHADOW_RAY_M`).
+#[inline]
+pub fn volume_optical_depth(
+    p: Vec3,
+    sun_dir: Vec3,
+    length: f32,
+    params: &VolumeParams,
+    stack: &VolumeStack,
+) -> f32 {
+    let dt = length / VOLUME_SHADOW_STEPS as f32;
+    let mut tau = 0.0;
+    for i in 0..VOLUME_SHADOW_STEPS {
+        tau += volume_density(p + sun_dir * ((i as f32 + 0.5) * dt), params, stack) * dt;
+    }
+    tau
+}
+
+/// The march of one ray (the twin of the WGSL `march_volume`):
+/// premultiplied cloud radiance and opacity.
+pub fn march_volume(
+    origin: Vec3,
+    dir: Vec3,
+    dither: f32,
+    params: &VolumeParams,
+    stack: &VolumeStack,
+    fr: &Frame,
+) -> Vec4 {
+    let q = &fr.quality;
+    let d = &fr.density;
+    let sky = &analytic(fr);
+    let Some((t0, t1)) = band_segment(origin, dir, d.band_bottom_m, d.band_top_m, q.max_distance_m)
+    else {
+        return Vec4::ZERO;
+    };
+    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let steps = q.steps.max(1);
+    let log_ratio = ((t1 + NEAR_M) / (t0 + NEAR_M)).ln();
+    let cos = dir.dot(sun_dir);
+    let sun = sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir);
+    let sky_top = sky_ambient(sky, sun_dir) * 0.25;
+    let ground = ground_up(sky, sun_dir, q.sea_wind_mps.is_some()) * 0.25;
+    let (mut transmittance, mut light, mut depth_weighted) = (1.0f32, Vec3::ZERO, 0.0f32);
+    for i in 0..steps {
+        let ta = march_distance(t0, log_ratio, i as f32 / steps as f32);
+        let tb = march_distance(t0, log_ratio, (i + 1) as f32 / steps as f32);
+        let t = ta + dither * (tb - ta);
+        let dt = tb - ta;
+        let p = origin + dir * t;
+        let sigma_t = volume_density(p, params, stack);
+        if sigma_t <= 0.0 {
+            continue;
+        }
+        let tau_sun =
+            volume_optical_depth(p, sun_dir, shadow_ray_length(p, sun_dir, d), params, stack);
+        let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
+        let ambient = ambient_light(sky_top, ground, eta);
+        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, q.octaves) + ambient)
+            * (sigma_t * ALBEDO);
+        let step_t = (-sigma_t * dt).exp();
+        light += integrate_step(src, sigma_t, dt) * transmittance;
+        depth_weighted += t * transmittance * (1.0 - step_t);
+        transmittance *= step_t;
+        if transmittance < MIN_TRANSMITTANCE {
+            break;
+        }
+    }
+    let opacity = 1.0 - transmittance;
+    let distance = if opacity > 0.0 {
+        depth_weighted / opacity
+    } else {
+        0.0
+    };
+    let (a_in, a_t) = aerial(sky, dir, distance, sun_dir);
+    (light * a_t + a_in * opacity).extend(opacity)
+}
+
+/// The sky the volume renderer draws under: the frame's, analytic.
+fn analytic<'a>(fr: &'a Frame) -> SkyLight<'a> {
+    SkyLight {
+        luts: None,
+        ..fr.sky_light()
+    }
+}
+
+/// A `width x height` image of linear radiance (row-major): per pixel the
+/// mean of `offsets` marches through its centre, march `k` with the
+/// dither shifted by the golden-ratio offset of frame `k` (one offset:
+/// the twin of the GPU's single `fs_volume` frame; more: the grain of
+/// the dither averaged away, as the cloud map's CPU path does with
+/// `render.cpu_offsets`).
+pub fn render_volume(
+    width: u32,
+    height: u32,
+    fr: &Frame,
+    params: &VolumeParams,
+    stack: &VolumeStack,
+    offsets: u32,
+) -> Vec<Vec3> {
+    let n = offsets.max(1);
+    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let sky = &analytic(fr);
+    let w = width as usize;
+    let mut out = vec![Vec3::ZERO; w * height as usize];
+    out.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, px) in row.iter_mut().enumerate() {
+                let dir = fr
+                    .view
+                    .camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
+                let d0 = spheroid_dither(x as u32, y as u32);
+                let c = (0..n)
+                    .map(|k| {
+                        let dither = (d0 + frame_offset(k)).fract();
+                        march_volume(fr.view.eye(), dir, dither, params, stack, fr)
+                    })
+                    .sum::<Vec4>()
+                    / n as f32;
+                let bg = background_radiance(
+                    sky,
+                    dir,
+                    sun_dir,
+                    fr.quality.sea_wind_mps,
+                    1.0,
+                    (Vec3::ZERO, 1.0),
+                );
+                *px = c.truncate() + (1.0 - c.w) * bg;
+            }
+        });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stack_of(values: [[u8; 8]; 2]) -> (VolumeStack, VolumeParams) {
+        // Two 2x2x2 volumes.
+        let vols: Vec<Vec<u8>> = values.iter().map(|v| v.to_vec()).collect();
+        let s = VolumeStack::new([2, 2, 2], &vols);
+        let p = VolumeParams {
+            origin: [0.0; 4],
+            extent: [200.0, 100.0, 200.0, 0.1],
+            dims: [2, 2, 2, 2],
+            pick: [0.0, 1.0, 0.25, 0.0],
+        };
+        (s, p)
+    }
+
+    #[test]
+    fn the_stack_puts_each_volume_in_its_own_rows() {
+        let (s, _) = stack_of([[1, 2, 3, 4, 5, 6, 7, 8], [11, 12, 13, 14, 15, 16, 17, 18]]);
+        assert_eq!(s.texture_size(), [2, 4, 2]);
+        // Volume 1, voxel (1, 0, 1) = its index (1·2 + 0)·2 + 1 = 5.
+        assert_eq!(volume_texel(&s, 1, 2, 1), 16.0 / 255.0);
+        assert_eq!(volume_texel(&s, 0, 1, 0), 3.0 / 255.0);
+    }
+
+    #[test]
+    fn samples_interpolate_wrap_across_and_blend_the_pair() {
+        let (s, p) = stack_of([[255; 8], [0; 8]]);
+        // Voxel centres: a full volume reads 1 anywhere inside the band.
+        let at = Vec3::new(50.0, 25.0, 50.0);
+        assert!((volume_sample(at, 0.0, &p, &s) - 1.0).abs() < 1e-6);
+        // Across the periodic edge it is still 1.
+        assert!((volume_sample(Vec3::new(-10.0, 25.0, 190.0), 0.0, &p, &s) - 1.0).abs() < 1e-6);
+        // Half a voxel past the top it has faded to half, a voxel past to 0.
+        assert!((volume_sample(Vec3::new(50.0, 100.0, 50.0), 0.0, &p, &s) - 0.5).abs() < 1e-6);
+        assert_eq!(
+            volume_sample(Vec3::new(50.0, 130.0, 50.0), 0.0, &p, &s),
+            0.0
+        );
+        // The blend: 3/4 of the first (full) and 1/4 of the second (empty).
+        assert!((volume_density(at, &p, &s) - 0.075).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_shadow_march_integrates_a_uniform_slab() {
+        let (s, mut p) = stack_of([[255; 8], [255; 8]]);
+        p.extent[1] = 1000.0;
+        let tau = volume_optical_depth(Vec3::new(50.0, 250.0, 50.0), Vec3::Y, 500.0, &p, &s);
+        // 0.1/m over 500 m (the last step reaches the fading top half voxel
+        // only at 3/4 of a voxel above 250 + 458: still full).
+        assert!((tau - 50.0).abs() < 1e-3, "tau {tau}");
+    }
+}

@@ -1,0 +1,184 @@
+//! `VolumeRenderer`: clouds played back from precomputed density volumes
+//! (Iwasaki, Nishino & Dobashi 2011; `crate::endless` builds the database
+//! and picks the pair each frame blends). Every volume is resident in one
+//! 8-bit 3D texture, stacked along `y`, uploaded once; a frame changes
+//! only the 64-byte pick. One full-screen pass straight into the target
+//! (`shaders/volume.wgsl`; the CPU twin is `render::cpu::volume`).
+
+use super::bind::{self, Recorder};
+use super::settings::GpuSettings;
+use super::{GpuContext, GpuError};
+use crate::render::camera::Camera;
+use crate::render::cpu::volume::{VolumeParams, VolumeStack};
+
+/// The volume renderer's WGSL.
+pub const VOLUME: &str = include_str!("../../../shaders/volume.wgsl");
+
+/// The volume renderer.
+pub struct VolumeRenderer {
+    queue: wgpu::Queue,
+    settings: GpuSettings,
+    uniforms: wgpu::Buffer,
+    params_buffer: wgpu::Buffer,
+    params: VolumeParams,
+    group0: wgpu::BindGroup,
+    group1: wgpu::BindGroup,
+    format: wgpu::TextureFormat,
+    pipeline: wgpu::RenderPipeline,
+    texture_bytes: u64,
+    width: u32,
+    height: u32,
+}
+
+impl VolumeRenderer {
+    /// The renderer of `stack` placed by `params` (its pick, the first
+    /// pair shown) for a target of `format`.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        format: wgpu::TextureFormat,
+        settings: &GpuSettings,
+        stack: &VolumeStack,
+        params: VolumeParams,
+    ) -> Result<Self, GpuError> {
+        let [w, h, d] = stack.texture_size();
+        let limit = device.limits().max_texture_dimension_3d;
+        if w.max(h).max(d) > limit {
+            return Err(GpuError::Wgpu(format!(
+                "the volume stack is {w}x{h}x{d} texels; this device's 3D textures stop at {limit}"
+            )));
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("volume.stack"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: d,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        super::textures::write_all(queue, &texture, &stack.texels, 1);
+        let uniforms = bind::uniform_buffer(device, "volume.frame_uniforms");
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume.params"),
+            size: size_of::<VolumeParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&params));
+        let group0_layout = bind::layout(device, "volume.group0", &[bind::uniform_entry(0)]);
+        let group1_layout = bind::layout(
+            device,
+            "volume.stack",
+            &[
+                bind::texture_3d_entry(0, wgpu::TextureSampleType::Float { filterable: false }),
+                bind::uniform_entry(1),
+            ],
+        );
+        let group0 = bind::bind(
+            device,
+            "volume.group0",
+            &group0_layout,
+            &[uniforms.as_entire_binding()],
+        );
+        let view = bind::view(&texture);
+        let group1 = bind::bind(
+            device,
+            "volume.stack",
+            &group1_layout,
+            &[
+                wgpu::BindingResource::TextureView(&view),
+                params_buffer.as_entire_binding(),
+            ],
+        );
+        let module = bind::module(device, "volume", super::shaders::volume_pass());
+        let pipeline = bind::full_screen_pipeline(
+            device,
+            "volume",
+            &module,
+            &[&group0_layout, &group1_layout],
+            &[Some(format.into())],
+            Some("fs_volume"),
+            &super::standalone::constants(settings, format),
+        );
+        Ok(Self {
+            queue: queue.clone(),
+            settings: *settings,
+            uniforms,
+            params_buffer,
+            params,
+            group0,
+            group1,
+            format,
+            pipeline,
+            texture_bytes: stack.texels.len() as u64,
+            width: 1,
+            height: 1,
+        })
+    }
+
+    /// Shows volumes `a` and `b` blended, `w` of `b`.
+    pub fn set_pick(&mut self, a: usize, b: usize, w: f32) {
+        self.params.pick = [a as f32, b as f32, w.clamp(0.0, 1.0), 0.0];
+        self.queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+    }
+
+    /// The resident volumes' size on the GPU, bytes.
+    pub fn texture_bytes(&self) -> u64 {
+        self.texture_bytes
+    }
+
+    /// The target's size.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        self.width = width;
+        self.height = height;
+    }
+
+    /// Records the frame; with `timestamps`, writes queries 0 and 1.
+    pub fn render(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        camera: &Camera,
+        timestamps: Option<&wgpu::QuerySet>,
+    ) {
+        if self.width == 0 || self.height == 0 {
+            return;
+        }
+        let u = super::standalone::uniforms(&self.settings, camera, self.width, self.height);
+        self.queue
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        let mut rec = Recorder::new(encoder, timestamps);
+        let mut pass = rec.begin(
+            "volume",
+            &[bind::color_attachment(target, Some(wgpu::Color::BLACK))],
+            None,
+        );
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group0, &[]);
+        pass.set_bind_group(1, &self.group1, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Renders one frame from `camera` into a new `width x height` target
+    /// and reads it back as 8-bit RGB, row-major (RGBA8 formats only).
+    pub fn read_rgb8(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, GpuError> {
+        self.resize(width, height);
+        let format = self.format;
+        super::standalone::read_rgb8(ctx, format, width, height, |e, view| {
+            self.render(e, view, camera, None)
+        })
+    }
+}
