@@ -68,6 +68,25 @@ const GOOD_SOUNDING: &str =
     "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n1000,,12,8\n3000,,0,-5\n";
 
 #[test]
+fn simulate_refuses_the_automaton_and_bad_methods_clearly() {
+    assert_simulate_fails(
+        "[simulation]\nmethod = \"automaton\"\n",
+        None,
+        &["bad.toml", "automaton", "no parcels"],
+    );
+    assert_simulate_fails(
+        "[simulation]\nmethod = \"voxels\"\n",
+        None,
+        &["bad.toml:2:", "parcels", "automaton", "endless"],
+    );
+    assert_simulate_fails(
+        "[simulation.endless]\ncells = [4, 4000, 4]\n",
+        None,
+        &["bad.toml:2:", "simulation.endless.cells"],
+    );
+}
+
+#[test]
 fn malformed_toml_names_file_and_line() {
     assert_simulate_fails(
         "name = \"x\"\n[physics\nparcels = 3\n",

@@ -113,7 +113,7 @@ pub fn panel(
             if ui.button("step (one dt)").clicked() {
                 a.step = true;
             }
-            ui.label(format!("t = {:.1} min", world.sim.time_s() / 60.0));
+            ui.label(format!("t = {:.1} min", world.time_s() / 60.0));
         });
         ui.separator();
         ui.label("Clouds and light");

@@ -1,5 +1,8 @@
-//! The live sky: a scene, its parcel simulation, P, the cloud map and the
-//! terrain, and the history of one picked parcel (the paper's Fig. 5).
+//! The live sky: a scene, its parcel simulation (or, with `[simulation]
+//! method = "automaton"`, its cellular automaton), P, the cloud map and
+//! the terrain, and the history of one picked parcel (the paper's Fig. 5).
+//! The demo draws every scene with the cloud map: the spheroid and
+//! endless-volume methods are `cumulus render`'s (it says so on load).
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -9,7 +12,8 @@ use cumulus::panel::PanelState;
 use cumulus::prepare::spawn_sites;
 use cumulus::render::cloud_map::CloudMap;
 use cumulus::render::terrain::Heightfield;
-use cumulus::scene::{Scene, SceneError};
+use cumulus::scene::{Method, RenderMethod, Scene, SceneError};
+use cumulus::sim::automaton::Automaton;
 use cumulus::sim::{Atmosphere, Band, ProjectedField, Simulation};
 
 /// One sample of the picked parcel's curves.
@@ -32,6 +36,10 @@ pub struct World {
     pub atmosphere: Atmosphere,
     pub band: Band,
     pub sim: Simulation,
+    /// The automaton, when the scene's method is one (then `sim` is idle).
+    pub automaton: Option<Automaton>,
+    /// Sky seconds the automaton has not yet stepped.
+    automaton_lag_s: f64,
     pub field: ProjectedField,
     pub cloud_map: CloudMap,
     pub terrain: Option<Heightfield>,
@@ -76,8 +84,19 @@ impl World {
             .enabled
             .then(|| Heightfield::generate(&scene.render.terrain));
         let panel = PanelState::from_scene(&scene, band);
+        if scene.simulation.method == Method::Endless
+            || scene.render.renderer == RenderMethod::Spheroids
+        {
+            eprintln!(
+                "{}: the demo animates it with the parcels and draws it with the cloud map; \
+                 `cumulus render --scene {0}` draws it with its own method (docs/methods.md)",
+                path.display()
+            );
+        }
         let mut w = Self {
             sim: Simulation::new(scene.physics.clone(), atmosphere.clone()),
+            automaton: None,
+            automaton_lag_s: 0.0,
             field: ProjectedField::new(scene.projection.width, scene.projection.height),
             scene,
             path,
@@ -102,6 +121,26 @@ impl World {
     /// cells and spun up for [`SPIN_UP_S`].
     pub fn restart_simulation(&mut self) {
         let l = self.scene.physics.domain_size_m;
+        self.automaton = None;
+        if self.scene.simulation.method == Method::Automaton {
+            let mut a = Automaton::new(
+                &self.scene.simulation.automaton,
+                &self.scene.physics,
+                self.band,
+                &spawn_sites(&self.cloud_map, l),
+                self.field.width(),
+                self.field.height(),
+            );
+            for _ in 0..(SPIN_UP_S / a.step_s()) as usize {
+                a.step();
+            }
+            self.automaton = Some(a);
+            self.automaton_lag_s = 0.0;
+            self.picked = None;
+            self.history.clear();
+            self.project();
+            return;
+        }
         let mut sim = Simulation::new(self.scene.physics.clone(), self.atmosphere.clone());
         sim.set_spawn_sites(spawn_sites(&self.cloud_map, l));
         let dt = self.scene.physics.dt_s;
@@ -126,6 +165,16 @@ impl World {
     /// Advances `sim_s` simulated seconds and projects.
     pub fn advance(&mut self, sim_s: f64) {
         let start = Instant::now();
+        if let Some(a) = &mut self.automaton {
+            self.automaton_lag_s += sim_s.min(10.0 * a.step_s());
+            while self.automaton_lag_s >= a.step_s() {
+                a.step();
+                self.automaton_lag_s -= a.step_s();
+            }
+            self.physics_ms = start.elapsed().as_secs_f64() * 1e3;
+            self.project();
+            return;
+        }
         let dt = self.scene.physics.dt_s;
         let mut left = sim_s.min(10.0 * dt);
         while left > 1e-9 {
@@ -138,10 +187,22 @@ impl World {
         self.project();
     }
 
+    /// Simulated seconds since the spin-up began (the automaton's steps
+    /// times its step, or the parcels' clock).
+    pub fn time_s(&self) -> f64 {
+        match &self.automaton {
+            Some(a) => a.steps() as f64 * a.step_s() + self.automaton_lag_s,
+            None => self.sim.time_s(),
+        }
+    }
+
     /// Projects the parcels into P.
     pub fn project(&mut self) {
         let start = Instant::now();
-        self.sim.project_into(&mut self.field, self.band);
+        match &self.automaton {
+            Some(a) => a.project_into(&mut self.field),
+            None => self.sim.project_into(&mut self.field, self.band),
+        }
         self.projection_ms = start.elapsed().as_secs_f64() * 1e3;
         self.field_version += 1;
     }

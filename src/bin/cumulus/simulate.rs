@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 
 use cumulus::io::write_atomically;
 use cumulus::report::curves;
@@ -59,6 +59,12 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             s.physics.seed = seed;
         }
     })?;
+    if scene.simulation.method == cumulus::scene::Method::Automaton {
+        bail!(
+            "{}: simulation.method = \"automaton\" has no parcels; `cumulus simulate` writes parcel curves (render the automaton with `cumulus render`)",
+            a.scene.display()
+        );
+    }
     finite_positive("--duration-s", a.duration_s)?;
     let every = a.every_s.unwrap_or(scene.physics.dt_s);
     finite_positive("--every-s", every)?;
