@@ -93,6 +93,7 @@ pub fn panel(
         }
         ui.separator();
         ui.label("Simulation");
+        let t_min = world.time_s() / 60.0;
         let p = &mut world.panel;
         let mut ch = false;
         ch |= unit_slider(ui, &mut p.parcels, 0..=10_000, "parcels (restarts)");
@@ -113,7 +114,7 @@ pub fn panel(
             if ui.button("step (one dt)").clicked() {
                 a.step = true;
             }
-            ui.label(format!("t = {:.1} min", world.time_s() / 60.0));
+            ui.label(format!("t = {t_min:.1} min"));
         });
         ui.separator();
         ui.label("Clouds and light");
