@@ -858,3 +858,71 @@ fn a_bad_ground_names_its_key() {
         &["bad.toml", "render.ground.wind_speed_mps", "0..=30"],
     );
 }
+
+#[test]
+fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = |coverage: f32| {
+        format!(
+            "[simulation]\nmethod = \"endless\"\n\n[simulation.endless]\nvolumes = 3\ninterval_s = 20.0\n\
+             cells = [16, 4, 16]\ndatabase = \"sky.volumes\"\n\n[render]\ntime_s = 300.0\ncoverage = {coverage}\n"
+        )
+    };
+    let path = dir.path().join("e.toml");
+    let render = |out: &str| {
+        let o = cumulus(&[
+            "render",
+            "--scene",
+            path.to_str().unwrap(),
+            "--backend",
+            "cpu",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--out",
+            dir.path().join(out).to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    std::fs::write(&path, scene(0.6)).unwrap();
+    assert!(
+        render("a.png").contains("wrote"),
+        "first run builds and writes"
+    );
+    let second = render("b.png");
+    assert!(second.contains("read from"), "{second}");
+    assert_eq!(
+        std::fs::read(dir.path().join("a.png")).unwrap(),
+        std::fs::read(dir.path().join("b.png")).unwrap(),
+        "the read database draws the same picture"
+    );
+    std::fs::write(&path, scene(0.5)).unwrap();
+    let third = render("c.png");
+    assert!(
+        third.contains("built") && third.contains("wrote"),
+        "{third}"
+    );
+    // A file that is not a database is an error, never overwritten.
+    std::fs::write(dir.path().join("sky.volumes"), "not volumes").unwrap();
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        path.to_str().unwrap(),
+        "--backend",
+        "cpu",
+        "--out",
+        dir.path().join("d.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not a cumulus volume database"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("sky.volumes")).unwrap(),
+        b"not volumes"
+    );
+}

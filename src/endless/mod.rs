@@ -11,11 +11,34 @@
 //! `[simulation] method = "endless"` chooses it; docs/methods.md
 //! compares it with live physics.
 
+mod file;
 mod player;
 
 use glam::Vec3;
 
+pub use file::{DatabaseFileError, fingerprint};
 pub use player::{Player, ThresholdRow, threshold_sweep};
+
+/// What went wrong building, reading or writing a database.
+#[derive(Debug, thiserror::Error)]
+pub enum EndlessError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    File(#[from] DatabaseFileError),
+}
+
+/// Where a database came from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Source {
+    /// Built in memory (no `database` key).
+    Built,
+    /// Read from this file.
+    Read(std::path::PathBuf),
+    /// Built and written to this file (none there, or made for other
+    /// settings).
+    Written(std::path::PathBuf),
+}
 
 use crate::prepare::Prepared;
 use crate::render::cpu::volume::{VolumeParams, VolumeStack};
@@ -102,6 +125,27 @@ impl Database {
             extinction_per_m: full,
             build_s: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The scene's database: read from `cfg.database` when that file was
+    /// made for these settings, else built (and written there).
+    pub fn load_or_build(
+        scene: &Scene,
+        cfg: &EndlessConfig,
+        progress: impl FnMut(),
+    ) -> Result<(Self, Source), EndlessError> {
+        let Some(path) = cfg.database_path(scene.source.as_deref()) else {
+            return Ok((Self::build(scene, cfg, progress)?, Source::Built));
+        };
+        let print = fingerprint(scene, cfg);
+        if path.exists()
+            && let Some(db) = Self::load(&path, print)?
+        {
+            return Ok((db, Source::Read(path)));
+        }
+        let db = Self::build(scene, cfg, progress)?;
+        db.save(&path, print)?;
+        Ok((db, Source::Written(path)))
     }
 
     /// Volumes stored.

@@ -64,6 +64,10 @@ pub struct EndlessConfig {
     /// volumes follow each other (few jumps, short loops); large, any
     /// volume may follow any (visible jumps). Default 0.5.
     pub similarity: f64,
+    /// Where the database is kept, relative to the scene file: read when
+    /// it was made for these settings, else built and written there.
+    /// Default: none (built in memory each run).
+    pub database: Option<std::path::PathBuf>,
 }
 
 impl Default for EndlessConfig {
@@ -73,11 +77,25 @@ impl Default for EndlessConfig {
             interval_s: 30.0,
             cells: [192, 32, 192],
             similarity: 0.5,
+            database: None,
         }
     }
 }
 
 impl EndlessConfig {
+    /// The database file, relative to the scene file's directory.
+    pub fn database_path(
+        &self,
+        scene_file: Option<&std::path::Path>,
+    ) -> Option<std::path::PathBuf> {
+        self.database.as_ref().map(|rel| {
+            scene_file
+                .and_then(std::path::Path::parent)
+                .map(|d| d.join(rel))
+                .unwrap_or_else(|| rel.clone())
+        })
+    }
+
     /// Every field against its domain.
     pub fn checks(&self) -> Vec<Check> {
         let [x, y, z] = self.cells;

@@ -398,7 +398,7 @@ fn render_endless(
     scene: &Scene,
     picture: Option<Picture>,
 ) -> Result<()> {
-    use cumulus::endless::{Database, Player};
+    use cumulus::endless::{Database, Player, Source};
     use cumulus::render::cpu::renderer::to_srgb8;
     use cumulus::render::cpu::volume::render_volume;
     use cumulus::render::gpu::volume_pass::VolumeRenderer;
@@ -414,16 +414,20 @@ fn render_endless(
         + (cfg.volumes.saturating_sub(1) as f64 * cfg.interval_s / scene.physics.dt_s).ceil()
             as u64;
     let bar = progress_bar(frames, "simulating and sampling the volumes");
-    let db = Database::build(scene, cfg, || bar.inc(1))?;
+    let (db, source) = Database::load_or_build(scene, cfg, || bar.inc(1))?;
     bar.finish_and_clear();
+    let whence = match source {
+        Source::Built => format!("built in {:.1} s", db.build_s),
+        Source::Read(p) => format!("read from {} (built in {:.1} s)", p.display(), db.build_s),
+        Source::Written(p) => format!("built in {:.1} s, wrote {}", db.build_s, p.display()),
+    };
     eprintln!(
-        "database: {} volumes of {}x{}x{} ({:.1} MB) built in {:.1} s",
+        "database: {} volumes of {}x{}x{} ({:.1} MB) {whence}",
         db.len(),
         db.dims[0],
         db.dims[1],
         db.dims[2],
         db.bytes() as f64 / 1e6,
-        db.build_s
     );
     let Some(out) = &a.out else { return Ok(()) };
     let mut player = Player::new(&db, cfg.similarity, scene.physics.seed);
