@@ -190,13 +190,13 @@ mod tests {
         assert!(Database::load(&path, 0xabd).expect("reads").is_none());
         // Truncated: a clear error, not a panic.
         let bytes = std::fs::read(&path).unwrap();
-        std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+        write_atomically(&path, |o| o.write_all(&bytes[..bytes.len() - 3])).unwrap();
         let e = Database::load(&path, 0xabc).expect_err("truncated");
         assert!(
             e.to_string().contains("shorter than its header says"),
             "{e}"
         );
-        std::fs::write(&path, b"hello\n").unwrap();
+        write_atomically(&path, |o| o.write_all(b"hello\n")).unwrap();
         let e = Database::load(&path, 0xabc).expect_err("not ours");
         assert!(
             e.to_string().contains("not a cumulus volume database"),
