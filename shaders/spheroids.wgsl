@@ -147,12 +147,6 @@ fn light_grid_depth(p: vec3f) -> f32 {
     return mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z);
 }
 
-// The per-pixel dither (interleaved gradient noise, Jimenez 2014), so the
-// renderer needs no blue-noise texture.
-fn spheroid_dither(x: u32, y: u32) -> f32 {
-    return fract(52.982918 * fract(0.06711056 * f32(x) + 0.00583715 * f32(y)));
-}
-
 // The march: the spheroids the ray crosses (the nearest MAX_CANDIDATES,
 // sorted by entry), their spans merged so no stretch is marched twice
 // (their "no duplicate tracing"), the steps spread evenly over the merged
@@ -249,20 +243,14 @@ fn march_spheroids(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
             break;
         }
     }
-    let opacity = 1.0 - transmittance;
-    var distance = 0.0;
-    if opacity > 0.0 {
-        distance = depth_weighted / opacity;
-    }
-    let a = aerial(dir, distance, sun_dir);
-    return vec4f(light * a.transmittance + a.inscatter * opacity, opacity);
+    return hazed_clouds(light, transmittance, depth_weighted, dir, sun_dir);
 }
 
 @fragment
 fn fs_spheroids(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let px = vec2u(pos.xy);
     let dir = camera_ray(pos.xy);
-    let c = march_spheroids(frame.cam_pos.xyz, dir, spheroid_dither(px.x, px.y));
+    let c = march_spheroids(frame.cam_pos.xyz, dir, standalone_dither(px.x, px.y));
     // No cloud shadows on its ground and no clouds in its sea: its bind
     // groups have no P or map.
     let bg = background_radiance(dir, frame.sun_dir.xyz, 1.0, vec4f(0.0, 0.0, 0.0, 1.0));

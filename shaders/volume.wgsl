@@ -118,26 +118,14 @@ fn march_volume(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
             break;
         }
     }
-    let opacity = 1.0 - transmittance;
-    var distance = 0.0;
-    if opacity > 0.0 {
-        distance = depth_weighted / opacity;
-    }
-    let a = aerial(dir, distance, sun_dir);
-    return vec4f(light * a.transmittance + a.inscatter * opacity, opacity);
-}
-
-// The per-pixel dither: the spheroid renderer's (interleaved gradient
-// noise), so the pass needs no blue-noise texture.
-fn spheroid_dither(x: u32, y: u32) -> f32 {
-    return fract(52.982918 * fract(0.06711056 * f32(x) + 0.00583715 * f32(y)));
+    return hazed_clouds(light, transmittance, depth_weighted, dir, sun_dir);
 }
 
 @fragment
 fn fs_volume(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let px = vec2u(pos.xy);
     let dir = camera_ray(pos.xy);
-    let c = march_volume(frame.cam_pos.xyz, dir, spheroid_dither(px.x, px.y));
+    let c = march_volume(frame.cam_pos.xyz, dir, standalone_dither(px.x, px.y));
     let bg = background_radiance(dir, frame.sun_dir.xyz, 1.0, vec4f(0.0, 0.0, 0.0, 1.0));
     return vec4f(display(c.rgb + (1.0 - c.a) * bg), 1.0);
 }

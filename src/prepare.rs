@@ -100,6 +100,15 @@ impl Prepared {
         })
     }
 
+    /// The scene's textures, band and extent with an empty P: nothing
+    /// simulated (for what fills the sky another way, or later).
+    pub fn unsimulated(scene: &Scene) -> Result<Self, SceneError> {
+        let mut bare = scene.clone();
+        bare.simulation.method = Method::Parcels;
+        bare.render.time_s = 0.0;
+        Self::from_scene(&bare, || {})
+    }
+
     /// The scene's parcels (whatever its method) at `count` moments
     /// `interval_s` apart, the first after `render.time_s`: `each` gets
     /// the moment's index and its fields (one simulation, P projected
@@ -111,12 +120,8 @@ impl Prepared {
         mut each: impl FnMut(usize, &Prepared),
         mut progress: impl FnMut(),
     ) -> Result<(), SceneError> {
-        // The textures without the simulation, which runs here.
-        let mut bare = scene.clone();
-        bare.simulation.method = Method::Parcels;
-        bare.render.time_s = 0.0;
         let atm = scene.atmosphere(None)?;
-        let mut p = Self::from_scene(&bare, || {})?;
+        let mut p = Self::unsimulated(scene)?;
         let mut sim = Simulation::new(scene.physics.clone(), atm);
         sim.set_spawn_sites(spawn_sites(&p.cloud_map, p.map_extent_m));
         let plan = FramePlan::new(scene.render.time_s, scene.physics.dt_s);

@@ -199,6 +199,19 @@ fn mask(img: &[u8], clear: &[u8]) -> Vec<bool> {
         .collect()
 }
 
+/// Two 8-bit pictures' mean channel difference, in levels, and the
+/// fraction of channels within 3 levels.
+fn agreement(gpu: &[u8], cpu: &[u8]) -> (f64, f64) {
+    let diff: Vec<u32> = gpu
+        .iter()
+        .zip(cpu)
+        .map(|(a, b)| a.abs_diff(*b) as u32)
+        .collect();
+    let mean = diff.iter().sum::<u32>() as f64 / diff.len() as f64;
+    let within = diff.iter().filter(|d| **d <= 3).count() as f64 / diff.len() as f64;
+    (mean, within)
+}
+
 #[test]
 fn spheroids_and_cloud_map_draw_the_same_parcels() {
     let Some(ctx) = gpu() else { return };
@@ -295,13 +308,7 @@ fn the_spheroid_renderer_matches_its_cpu_twin() {
     let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
     let grid = LightGrid::build(&spheroids, sun, frame.density.extinction_per_m);
     let cpu = render_spheroids_srgb8(w, h, &frame, &spheroids, &grid);
-    let diff: Vec<u32> = gpu
-        .iter()
-        .zip(&cpu)
-        .map(|(a, b)| a.abs_diff(*b) as u32)
-        .collect();
-    let mean = diff.iter().sum::<u32>() as f64 / diff.len() as f64;
-    let within = diff.iter().filter(|d| **d <= 3).count() as f64 / diff.len() as f64;
+    let (mean, within) = agreement(&gpu, &cpu);
     // The clouds are in the picture: it is not the clear sky on both.
     let clear = {
         let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
@@ -352,9 +359,7 @@ fn the_volume_renderer_matches_its_cpu_twin_on_a_blend() {
     let mut player = Player::new(&db, cfg.similarity, 1);
     // Halfway through the first interval: two volumes blended.
     let (stack, params) = db.stack(player.at(0.5 * db.interval_s, db.interval_s));
-    let mut bare = sc.clone();
-    bare.render.time_s = 0.0;
-    let p = Prepared::from_scene(&bare, || {}).unwrap();
+    let p = Prepared::unsimulated(&sc).unwrap();
     let r = &sc.render;
     let settings = p.gpu_settings(r, r.quality());
     let mut v = VolumeRenderer::new(
@@ -369,13 +374,7 @@ fn the_volume_renderer_matches_its_cpu_twin_on_a_blend() {
     let gpu = v.read_rgb8(&ctx, &r.camera(), w, h).unwrap();
     let frame = p.frame(r, r.quality());
     let cpu = to_srgb8(&render_volume(w, h, &frame, &params, &stack, 1), r.exposure);
-    let diff: Vec<u32> = gpu
-        .iter()
-        .zip(&cpu)
-        .map(|(a, b)| a.abs_diff(*b) as u32)
-        .collect();
-    let mean = diff.iter().sum::<u32>() as f64 / diff.len() as f64;
-    let within = diff.iter().filter(|d| **d <= 3).count() as f64 / diff.len() as f64;
+    let (mean, within) = agreement(&gpu, &cpu);
     let mut empty = stack.clone();
     empty.texels.fill(0);
     let clear = to_srgb8(&render_volume(w, h, &frame, &params, &empty, 1), r.exposure);

@@ -42,8 +42,10 @@ pub enum Source {
 
 use crate::prepare::Prepared;
 use crate::render::cpu::volume::{VolumeParams, VolumeStack};
+use crate::render::gpu::GpuSettings;
 use crate::report::volume_export::{Grid, sample};
-use crate::scene::{EndlessConfig, Scene, SceneError};
+use crate::scene::{EndlessConfig, RenderSettings, Scene, SceneError};
+use crate::sim::Band;
 
 /// The database: the volumes, their distances, and where they lie.
 #[derive(Debug, Clone)]
@@ -146,6 +148,16 @@ impl Database {
         let db = Self::build(scene, cfg, progress)?;
         db.save(&path, print)?;
         Ok((db, Source::Written(path)))
+    }
+
+    /// The volume renderer's settings for `r`: its band and extent are
+    /// the database's box.
+    pub fn gpu_settings(&self, r: &RenderSettings) -> GpuSettings {
+        let band = Band {
+            bottom_m: self.origin.y as f64,
+            top_m: (self.origin.y + self.extent.y) as f64,
+        };
+        r.gpu_settings_at(band, self.extent.x as f64, r.quality())
     }
 
     /// Volumes stored.

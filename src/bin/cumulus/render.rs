@@ -96,7 +96,7 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::renderer::{render_linear_offsets, to_srgb8};
+    use cumulus::render::cpu::renderer::render_linear_offsets;
     use cumulus::report::render_quality;
 
     let flags = [
@@ -222,16 +222,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let linear = render_linear_offsets(r.width, r.height, &frame, r.cpu_offsets);
     let elapsed = start.elapsed();
 
-    if picture == Some(Picture::Exr) {
-        let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
-        write_exr(out, r.width, r.height, rgb)?;
-    } else {
-        let bytes = to_srgb8(&linear, r.exposure);
-        let img =
-            image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
-        write_png_atomically(out, &img)
-            .with_context(|| format!("{}: cannot write image", out.display()))?;
-    }
+    write_linear(out, picture, r, &linear)?;
     eprintln!(
         "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
@@ -273,11 +264,7 @@ fn render_gpu(
         if let Some(rgb) = hl.read_linear(ctx)? {
             write_exr(out, r.width, r.height, rgb)?;
         } else {
-            let bytes = hl.read_rgb8(ctx)?;
-            let img =
-                image::RgbImage::from_raw(r.width, r.height, bytes).context("image buffer size")?;
-            write_png_atomically(out, &img)
-                .with_context(|| format!("{}: cannot write image", out.display()))?;
+            write_rgb8(out, r.width, r.height, hl.read_rgb8(ctx)?)?;
         }
         eprintln!(
             "rendered {}x{}, {frames} frame(s) in {:.2} s ({} steps, {} shadow steps, {} octaves, TSAA {}; passes {}); wrote {}",
@@ -329,7 +316,6 @@ fn render_spheroids(
     prepared: &Prepared,
     picture: Option<Picture>,
 ) -> Result<()> {
-    use cumulus::render::cpu::renderer::to_srgb8;
     use cumulus::render::cpu::sky::sun_direction;
     use cumulus::render::cpu::spheroids::{LightGrid, render_spheroids as cpu_render};
     use cumulus::render::gpu::spheroids::SpheroidRenderer;
@@ -343,7 +329,7 @@ fn render_spheroids(
     let Some(out) = &a.out else { return Ok(()) };
     let spheroids = prepared.spheroids();
     let start = std::time::Instant::now();
-    let rgb8 = match gpu {
+    match gpu {
         Some(ctx) => {
             if picture == Some(Picture::Exr) {
                 bail!(
@@ -355,29 +341,21 @@ fn render_spheroids(
             let settings = prepared.gpu_settings(r, r.quality());
             let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
             s.update_spheroids(&spheroids);
-            s.read_rgb8(ctx, &r.camera(), r.width, r.height)?
+            write_rgb8(
+                out,
+                r.width,
+                r.height,
+                s.read_rgb8(ctx, &r.camera(), r.width, r.height)?,
+            )?;
         }
         None => {
             let frame = prepared.frame(r, r.quality());
             let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
             let grid = LightGrid::build(&spheroids, sun, frame.density.extinction_per_m);
             let linear = cpu_render(r.width, r.height, &frame, &spheroids, &grid);
-            if picture == Some(Picture::Exr) {
-                let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
-                write_exr(out, r.width, r.height, rgb)?;
-                eprintln!(
-                    "rendered {} spheroids; wrote {}",
-                    spheroids.len(),
-                    out.display()
-                );
-                return Ok(());
-            }
-            to_srgb8(&linear, r.exposure)
+            write_linear(out, picture, r, &linear)?;
         }
-    };
-    let img = image::RgbImage::from_raw(r.width, r.height, rgb8).context("image buffer size")?;
-    write_png_atomically(out, &img)
-        .with_context(|| format!("{}: cannot write image", out.display()))?;
+    }
     eprintln!(
         "rendered {}x{} with {} pseudo-spheroids in {:.2} s; wrote {}",
         r.width,
@@ -399,7 +377,6 @@ fn render_endless(
     picture: Option<Picture>,
 ) -> Result<()> {
     use cumulus::endless::{Database, Player, Source};
-    use cumulus::render::cpu::renderer::to_srgb8;
     use cumulus::render::cpu::volume::render_volume;
     use cumulus::render::gpu::volume_pass::VolumeRenderer;
 
@@ -432,7 +409,7 @@ fn render_endless(
     let Some(out) = &a.out else { return Ok(()) };
     let mut player = Player::new(&db, cfg.similarity, scene.physics.seed);
     let (stack, params) = db.stack(player.at(0.0, db.interval_s));
-    let rgb8 = match gpu {
+    match gpu {
         Some(ctx) => {
             if picture == Some(Picture::Exr) {
                 bail!(
@@ -441,14 +418,7 @@ fn render_endless(
                 );
             }
             eprintln!("backend: gpu ({})", ctx.describe());
-            let settings = r.gpu_settings_at(
-                cumulus::sim::Band {
-                    bottom_m: db.origin.y as f64,
-                    top_m: (db.origin.y + db.extent.y) as f64,
-                },
-                db.extent.x as f64,
-                r.quality(),
-            );
+            let settings = db.gpu_settings(r);
             let mut v = VolumeRenderer::new(
                 &ctx.device,
                 &ctx.queue,
@@ -457,27 +427,20 @@ fn render_endless(
                 &stack,
                 params,
             )?;
-            v.read_rgb8(ctx, &r.camera(), r.width, r.height)?
+            write_rgb8(
+                out,
+                r.width,
+                r.height,
+                v.read_rgb8(ctx, &r.camera(), r.width, r.height)?,
+            )?;
         }
         None => {
-            let mut bare = scene.clone();
-            bare.simulation.method = Method::Parcels;
-            bare.render.time_s = 0.0;
-            let p = Prepared::from_scene(&bare, || {})?;
+            let p = Prepared::unsimulated(scene)?;
             let frame = p.frame(r, r.quality());
             let linear = render_volume(r.width, r.height, &frame, &params, &stack, r.cpu_offsets);
-            if picture == Some(Picture::Exr) {
-                let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
-                write_exr(out, r.width, r.height, rgb)?;
-                eprintln!("wrote {}", out.display());
-                return Ok(());
-            }
-            to_srgb8(&linear, r.exposure)
+            write_linear(out, picture, r, &linear)?;
         }
-    };
-    let img = image::RgbImage::from_raw(r.width, r.height, rgb8).context("image buffer size")?;
-    write_png_atomically(out, &img)
-        .with_context(|| format!("{}: cannot write image", out.display()))?;
+    }
     eprintln!(
         "rendered {}x{} from the volumes; wrote {}",
         r.width,
@@ -485,4 +448,27 @@ fn render_endless(
         out.display()
     );
     Ok(())
+}
+
+/// Writes a CPU picture: OpenEXR of the linear radiance, or the PNG of its
+/// tone map at `r.exposure`.
+fn write_linear(
+    out: &Path,
+    picture: Option<Picture>,
+    r: &cumulus::scene::RenderSettings,
+    linear: &[glam::Vec3],
+) -> Result<()> {
+    if picture == Some(Picture::Exr) {
+        let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
+        return write_exr(out, r.width, r.height, rgb);
+    }
+    let bytes = cumulus::render::cpu::renderer::to_srgb8(linear, r.exposure);
+    write_rgb8(out, r.width, r.height, bytes)
+}
+
+/// Writes 8-bit RGB rows as a PNG, atomically.
+fn write_rgb8(out: &Path, width: u32, height: u32, bytes: Vec<u8>) -> Result<()> {
+    let img = image::RgbImage::from_raw(width, height, bytes).context("image buffer size")?;
+    write_png_atomically(out, &img)
+        .with_context(|| format!("{}: cannot write image", out.display()))
 }

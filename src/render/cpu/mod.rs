@@ -13,5 +13,6 @@ pub mod renderer;
 pub mod sky;
 pub mod sky_luts;
 pub mod spheroids;
+pub mod standalone;
 pub mod tone_map;
 pub mod volume;

@@ -16,9 +16,8 @@ use rayon::prelude::*;
 
 use super::lighting::{integrate_step, sun_scattering};
 use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, to_srgb8};
-use super::sky::{
-    SkyLight, aerial, background_radiance, ground_up, sky_ambient, sun_direction, sun_light_at,
-};
+use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
+use super::standalone::{analytic, hazed_clouds, render_standalone};
 
 /// How far the fBm moves a spheroid's surface (κ of their Eq. 2).
 pub const SPHEROID_KAPPA: f32 = 0.35;
@@ -313,12 +312,6 @@ pub fn light_grid_depth(p: Vec3, grid: &LightGrid) -> f32 {
     mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z)
 }
 
-/// The per-pixel dither (interleaved gradient noise, Jimenez 2014).
-#[inline]
-pub fn spheroid_dither(x: u32, y: u32) -> f32 {
-    (52.982_918 * (0.067_110_56 * x as f32 + 0.005_837_15 * y as f32).fract()).fract()
-}
-
 /// The nearest [`MAX_CANDIDATES`] spheroids the ray meets before
 /// `max_t`, sorted by entry: (index, entry, exit).
 fn spheroid_candidates(
@@ -413,22 +406,7 @@ pub fn march_spheroids(
             break;
         }
     }
-    let opacity = 1.0 - transmittance;
-    let distance = if opacity > 0.0 {
-        depth_weighted / opacity
-    } else {
-        0.0
-    };
-    let (a_in, a_t) = aerial(sky, dir, distance, sun_dir);
-    (light * a_t + a_in * opacity).extend(opacity)
-}
-
-/// The sky the spheroid renderer draws under: the frame's, analytic.
-fn analytic<'a>(fr: &'a Frame) -> SkyLight<'a> {
-    SkyLight {
-        luts: None,
-        ..fr.sky_light()
-    }
+    hazed_clouds(sky, light, transmittance, depth_weighted, dir, sun_dir)
 }
 
 /// A `width x height` image of linear radiance (row-major), the twin of
@@ -440,31 +418,9 @@ pub fn render_spheroids(
     spheroids: &[Spheroid],
     grid: &LightGrid,
 ) -> Vec<Vec3> {
-    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
-    let sky = &analytic(fr);
-    let w = width as usize;
-    let mut out = vec![Vec3::ZERO; w * height as usize];
-    out.par_chunks_mut(w.max(1))
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, px) in row.iter_mut().enumerate() {
-                let dir = fr
-                    .view
-                    .camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
-                let dither = spheroid_dither(x as u32, y as u32);
-                let c = march_spheroids(fr.view.eye(), dir, dither, spheroids, grid, fr);
-                let bg = background_radiance(
-                    sky,
-                    dir,
-                    sun_dir,
-                    fr.quality.sea_wind_mps,
-                    1.0,
-                    (Vec3::ZERO, 1.0),
-                );
-                *px = c.truncate() + (1.0 - c.w) * bg;
-            }
-        });
-    out
+    render_standalone(width, height, fr, 1, |origin, dir, dither| {
+        march_spheroids(origin, dir, dither, spheroids, grid, fr)
+    })
 }
 
 /// [`render_spheroids`] tone-mapped to sRGB8 with the frame's exposure.

@@ -14,16 +14,12 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
-use rayon::prelude::*;
 
 use super::density::band_segment;
 use super::lighting::{integrate_step, shadow_ray_length, sun_scattering};
 use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, NEAR_M, ambient_light, march_distance};
-use super::sky::{
-    SkyLight, aerial, background_radiance, ground_up, sky_ambient, sun_direction, sun_light_at,
-};
-use super::spheroids::spheroid_dither;
-use crate::render::sampling::frame_offset;
+use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
+use super::standalone::{analytic, hazed_clouds, render_standalone};
 
 /// Samples of a lit sample's shadow march towards the sun.
 pub const VOLUME_SHADOW_STEPS: u32 = 6;
@@ -218,30 +214,12 @@ pub fn march_volume(
             break;
         }
     }
-    let opacity = 1.0 - transmittance;
-    let distance = if opacity > 0.0 {
-        depth_weighted / opacity
-    } else {
-        0.0
-    };
-    let (a_in, a_t) = aerial(sky, dir, distance, sun_dir);
-    (light * a_t + a_in * opacity).extend(opacity)
-}
-
-/// The sky the volume renderer draws under: the frame's, analytic.
-fn analytic<'a>(fr: &'a Frame) -> SkyLight<'a> {
-    SkyLight {
-        luts: None,
-        ..fr.sky_light()
-    }
+    hazed_clouds(sky, light, transmittance, depth_weighted, dir, sun_dir)
 }
 
 /// A `width x height` image of linear radiance (row-major): per pixel the
-/// mean of `offsets` marches through its centre, march `k` with the
-/// dither shifted by the golden-ratio offset of frame `k` (one offset:
-/// the twin of the GPU's single `fs_volume` frame; more: the grain of
-/// the dither averaged away, as the cloud map's CPU path does with
-/// `render.cpu_offsets`).
+/// mean of `offsets` marches ([`render_standalone`]; one offset: the twin
+/// of the GPU's single `fs_volume` frame).
 pub fn render_volume(
     width: u32,
     height: u32,
@@ -250,38 +228,9 @@ pub fn render_volume(
     stack: &VolumeStack,
     offsets: u32,
 ) -> Vec<Vec3> {
-    let n = offsets.max(1);
-    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
-    let sky = &analytic(fr);
-    let w = width as usize;
-    let mut out = vec![Vec3::ZERO; w * height as usize];
-    out.par_chunks_mut(w.max(1))
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, px) in row.iter_mut().enumerate() {
-                let dir = fr
-                    .view
-                    .camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
-                let d0 = spheroid_dither(x as u32, y as u32);
-                let c = (0..n)
-                    .map(|k| {
-                        let dither = (d0 + frame_offset(k)).fract();
-                        march_volume(fr.view.eye(), dir, dither, params, stack, fr)
-                    })
-                    .sum::<Vec4>()
-                    / n as f32;
-                let bg = background_radiance(
-                    sky,
-                    dir,
-                    sun_dir,
-                    fr.quality.sea_wind_mps,
-                    1.0,
-                    (Vec3::ZERO, 1.0),
-                );
-                *px = c.truncate() + (1.0 - c.w) * bg;
-            }
-        });
-    out
+    render_standalone(width, height, fr, offsets, |origin, dir, dither| {
+        march_volume(origin, dir, dither, params, stack, fr)
+    })
 }
 
 #[cfg(test)]

@@ -17,6 +17,8 @@ pub const TERRAIN: &str = include_str!("../../../shaders/terrain.wgsl");
 pub const SKY_LUTS: &str = include_str!("../../../shaders/sky_luts.wgsl");
 /// The sky tables' compute entry points (after [`SKY_LUTS`]).
 pub const SKY_LUTS_BUILD: &str = include_str!("../../../shaders/sky_luts_build.wgsl");
+/// What the spheroid and volume passes share (after [`COMPOSITE`]).
+pub const STANDALONE: &str = include_str!("../../../shaders/standalone.wgsl");
 /// The analytic sky's functions (after [`CLOUDS`]).
 pub const SKY_ANALYTIC: &str = include_str!("../../../shaders/sky_analytic.wgsl");
 /// The physical sky's functions and table bindings (after [`CLOUDS`] and
@@ -114,7 +116,7 @@ pub fn terrain_pass(physical: bool) -> String {
 /// alone, so it draws under the analytic sky).
 pub fn spheroids_pass() -> String {
     format!(
-        "{}{COMPOSITE}\n{}",
+        "{}{COMPOSITE}\n{STANDALONE}\n{}",
         shared(false),
         super::spheroids::SPHEROIDS
     )
@@ -124,7 +126,7 @@ pub fn spheroids_pass() -> String {
 /// analytic sky).
 pub fn volume_pass() -> String {
     format!(
-        "{}{COMPOSITE}\n{}",
+        "{}{COMPOSITE}\n{STANDALONE}\n{}",
         shared(false),
         super::volume_pass::VOLUME
     )

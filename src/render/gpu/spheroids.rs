@@ -7,8 +7,9 @@
 //! unlike the cloud-map pass. Same lighting, analytic sky and tone map
 //! (`shaders/spheroids.wgsl` calls the cloud pass's functions).
 
-use super::bind::{self, Recorder};
+use super::bind;
 use super::settings::GpuSettings;
+use super::standalone::StandalonePass;
 use crate::render::camera::Camera;
 
 use crate::render::cpu::sky::sun_direction;
@@ -22,9 +23,7 @@ pub const SPHEROIDS: &str = include_str!("../../../shaders/spheroids.wgsl");
 pub struct SpheroidRenderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    settings: GpuSettings,
-    uniforms: wgpu::Buffer,
-    group0: wgpu::BindGroup,
+    pass: StandalonePass,
     group1_layout: wgpu::BindGroupLayout,
     group1: wgpu::BindGroup,
     buffer: wgpu::Buffer,
@@ -32,10 +31,6 @@ pub struct SpheroidRenderer {
     count: usize,
     grid_words: usize,
     grid_ms: f64,
-    format: wgpu::TextureFormat,
-    pipeline: wgpu::RenderPipeline,
-    width: u32,
-    height: u32,
 }
 
 impl SpheroidRenderer {
@@ -47,29 +42,20 @@ impl SpheroidRenderer {
         format: wgpu::TextureFormat,
         settings: &GpuSettings,
     ) -> Self {
-        let uniforms = bind::uniform_buffer(device, "spheroids.frame_uniforms");
-        let group0_layout = bind::layout(device, "spheroids.group0", &[bind::uniform_entry(0)]);
         let group1_layout = bind::layout(
             device,
             "spheroids.primitives",
             &[bind::storage_entry(0), bind::storage_entry(1)],
         );
-        let group0 = bind::bind(
+        let pass = StandalonePass::new(
             device,
-            "spheroids.group0",
-            &group0_layout,
-            &[uniforms.as_entire_binding()],
-        );
-        let module = bind::module(device, "spheroids", super::shaders::spheroids_pass());
-        let constants = super::standalone::constants(settings, format);
-        let pipeline = bind::full_screen_pipeline(
-            device,
+            queue,
+            format,
+            settings,
             "spheroids",
-            &module,
-            &[&group0_layout, &group1_layout],
-            &[Some(format.into())],
-            Some("fs_spheroids"),
-            &constants,
+            super::shaders::spheroids_pass(),
+            "fs_spheroids",
+            &group1_layout,
         );
         let buffer = Self::storage(device, "spheroids.spheroids", 32);
         let grid_buffer = Self::storage(device, "spheroids.light_grid", 16);
@@ -77,9 +63,7 @@ impl SpheroidRenderer {
         let mut r = Self {
             device: device.clone(),
             queue: queue.clone(),
-            settings: *settings,
-            uniforms,
-            group0,
+            pass,
             group1_layout,
             group1,
             buffer,
@@ -87,10 +71,6 @@ impl SpheroidRenderer {
             count: 0,
             grid_words: 0,
             grid_ms: 0.0,
-            format,
-            pipeline,
-            width: 1,
-            height: 1,
         };
         r.update_spheroids(&[]);
         r
@@ -133,11 +113,9 @@ impl SpheroidRenderer {
             spheroids
         };
         let start = std::time::Instant::now();
-        let sun = sun_direction(
-            self.settings.sun_elevation_deg,
-            self.settings.sun_azimuth_deg,
-        );
-        let grid = LightGrid::build(spheroids, sun, self.settings.density.extinction_per_m);
+        let settings = self.pass.settings();
+        let sun = sun_direction(settings.sun_elevation_deg, settings.sun_azimuth_deg);
+        let grid = LightGrid::build(spheroids, sun, settings.density.extinction_per_m);
         let words = grid.to_words();
         self.grid_ms = start.elapsed().as_secs_f64() * 1e3;
         if data.len() != self.count || words.len() != self.grid_words {
@@ -166,8 +144,7 @@ impl SpheroidRenderer {
 
     /// The target's size.
     pub fn resize(&mut self, width: u32, height: u32) {
-        self.width = width;
-        self.height = height;
+        self.pass.resize(width, height);
     }
 
     /// Records the frame; with `timestamps`, writes queries 0 and 1.
@@ -178,26 +155,10 @@ impl SpheroidRenderer {
         camera: &Camera,
         timestamps: Option<&wgpu::QuerySet>,
     ) {
-        if self.width == 0 || self.height == 0 {
-            return;
-        }
-        let u = super::standalone::uniforms(&self.settings, camera, self.width, self.height);
-        self.queue
-            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let mut rec = Recorder::new(encoder, timestamps);
-        let mut pass = rec.begin(
-            "spheroids",
-            &[bind::color_attachment(target, Some(wgpu::Color::BLACK))],
-            None,
-        );
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.group0, &[]);
-        pass.set_bind_group(1, &self.group1, &[]);
-        pass.draw(0..3, 0..1);
+        self.pass
+            .draw(encoder, target, camera, timestamps, &self.group1);
     }
-}
 
-impl SpheroidRenderer {
     /// Renders one frame from `camera` into a new `width x height` target
     /// of the renderer's format and reads it back as 8-bit RGB, row-major
     /// (`Err` for other than an RGBA8 format: read those yourself).
@@ -208,10 +169,7 @@ impl SpheroidRenderer {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, super::GpuError> {
-        self.resize(width, height);
-        let format = self.format;
-        super::standalone::read_rgb8(ctx, format, width, height, |e, view| {
-            self.render(e, view, camera, None)
-        })
+        self.pass
+            .read_rgb8(ctx, camera, width, height, &self.group1)
     }
 }

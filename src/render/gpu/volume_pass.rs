@@ -5,8 +5,9 @@
 //! only the 64-byte pick. One full-screen pass straight into the target
 //! (`shaders/volume.wgsl`; the CPU twin is `render::cpu::volume`).
 
-use super::bind::{self, Recorder};
+use super::bind;
 use super::settings::GpuSettings;
+use super::standalone::StandalonePass;
 use super::{GpuContext, GpuError};
 use crate::render::camera::Camera;
 use crate::render::cpu::volume::{VolumeParams, VolumeStack};
@@ -17,17 +18,11 @@ pub const VOLUME: &str = include_str!("../../../shaders/volume.wgsl");
 /// The volume renderer.
 pub struct VolumeRenderer {
     queue: wgpu::Queue,
-    settings: GpuSettings,
-    uniforms: wgpu::Buffer,
+    pass: StandalonePass,
     params_buffer: wgpu::Buffer,
     params: VolumeParams,
-    group0: wgpu::BindGroup,
     group1: wgpu::BindGroup,
-    format: wgpu::TextureFormat,
-    pipeline: wgpu::RenderPipeline,
     texture_bytes: u64,
-    width: u32,
-    height: u32,
 }
 
 impl VolumeRenderer {
@@ -63,7 +58,6 @@ impl VolumeRenderer {
             view_formats: &[],
         });
         super::textures::write_all(queue, &texture, &stack.texels, 1);
-        let uniforms = bind::uniform_buffer(device, "volume.frame_uniforms");
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("volume.params"),
             size: size_of::<VolumeParams>() as u64,
@@ -71,7 +65,6 @@ impl VolumeRenderer {
             mapped_at_creation: false,
         });
         queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&params));
-        let group0_layout = bind::layout(device, "volume.group0", &[bind::uniform_entry(0)]);
         let group1_layout = bind::layout(
             device,
             "volume.stack",
@@ -79,12 +72,6 @@ impl VolumeRenderer {
                 bind::texture_3d_entry(0, wgpu::TextureSampleType::Float { filterable: false }),
                 bind::uniform_entry(1),
             ],
-        );
-        let group0 = bind::bind(
-            device,
-            "volume.group0",
-            &group0_layout,
-            &[uniforms.as_entire_binding()],
         );
         let view = bind::view(&texture);
         let group1 = bind::bind(
@@ -96,29 +83,23 @@ impl VolumeRenderer {
                 params_buffer.as_entire_binding(),
             ],
         );
-        let module = bind::module(device, "volume", super::shaders::volume_pass());
-        let pipeline = bind::full_screen_pipeline(
+        let pass = StandalonePass::new(
             device,
+            queue,
+            format,
+            settings,
             "volume",
-            &module,
-            &[&group0_layout, &group1_layout],
-            &[Some(format.into())],
-            Some("fs_volume"),
-            &super::standalone::constants(settings, format),
+            super::shaders::volume_pass(),
+            "fs_volume",
+            &group1_layout,
         );
         Ok(Self {
             queue: queue.clone(),
-            settings: *settings,
-            uniforms,
+            pass,
             params_buffer,
             params,
-            group0,
             group1,
-            format,
-            pipeline,
             texture_bytes: stack.texels.len() as u64,
-            width: 1,
-            height: 1,
         })
     }
 
@@ -136,8 +117,7 @@ impl VolumeRenderer {
 
     /// The target's size.
     pub fn resize(&mut self, width: u32, height: u32) {
-        self.width = width;
-        self.height = height;
+        self.pass.resize(width, height);
     }
 
     /// Records the frame; with `timestamps`, writes queries 0 and 1.
@@ -148,22 +128,8 @@ impl VolumeRenderer {
         camera: &Camera,
         timestamps: Option<&wgpu::QuerySet>,
     ) {
-        if self.width == 0 || self.height == 0 {
-            return;
-        }
-        let u = super::standalone::uniforms(&self.settings, camera, self.width, self.height);
-        self.queue
-            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let mut rec = Recorder::new(encoder, timestamps);
-        let mut pass = rec.begin(
-            "volume",
-            &[bind::color_attachment(target, Some(wgpu::Color::BLACK))],
-            None,
-        );
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.group0, &[]);
-        pass.set_bind_group(1, &self.group1, &[]);
-        pass.draw(0..3, 0..1);
+        self.pass
+            .draw(encoder, target, camera, timestamps, &self.group1);
     }
 
     /// Renders one frame from `camera` into a new `width x height` target
@@ -175,10 +141,7 @@ impl VolumeRenderer {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, GpuError> {
-        self.resize(width, height);
-        let format = self.format;
-        super::standalone::read_rgb8(ctx, format, width, height, |e, view| {
-            self.render(e, view, camera, None)
-        })
+        self.pass
+            .read_rgb8(ctx, camera, width, height, &self.group1)
     }
 }

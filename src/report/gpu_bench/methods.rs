@@ -1,21 +1,24 @@
 //! The animation and rendering methods side by side on one scene: the
 //! cloud map fed by the parcels (ours), the cloud map fed by the cellular
-//! automaton, and the pseudo-spheroid renderer of the same parcels; for
-//! each, the frame, the simulation step and (spheroids) the light grid's
-//! CPU build.
+//! automaton, the pseudo-spheroid renderer of the same parcels, and the
+//! endless volumes; for each, the frame, the simulation step, (spheroids)
+//! the light grid's CPU build and the state kept on the GPU; and the
+//! endless playback's jumps against its similarity temperature.
 
 use std::time::Instant;
 
-use super::timing::{time_cloud_map, time_spheroids, time_volume};
+use super::timing::{spheroid_renderer, time_cloud_map, time_pass};
 use super::{BenchError, BenchOptions, MethodRow};
 use crate::endless::{Database, Player, ThresholdRow, threshold_sweep};
 use crate::prepare::{Prepared, spawn_sites};
 use crate::render::cloud_map::CloudMap;
+use crate::render::cpu::spheroids::{LIGHT_GRID_DIMS, Spheroid};
 use crate::render::gpu::GpuContext;
-use crate::render::gpu::spheroids::SpheroidRenderer;
+use crate::render::gpu::headless::TARGET_FORMAT;
 use crate::render::gpu::textures::field_texels;
 use crate::render::gpu::timer::FrameTimes;
-use crate::scene::{Method, Scene};
+use crate::render::gpu::volume_pass::VolumeRenderer;
+use crate::scene::{Method, RenderSettings, Scene};
 use crate::sim::Simulation;
 use crate::sim::automaton::Automaton;
 
@@ -31,17 +34,44 @@ fn median_ms(samples: usize, mut f: impl FnMut()) -> f64 {
     FrameTimes::quantile(&v, 0.5)
 }
 
-/// One simulation step of `sc`'s method, spun up for the scene's
-/// `time_s` (at most 240 steps), ms and the sky seconds it advances.
-fn step_cost(sc: &Scene, samples: usize) -> Result<(f64, f64), BenchError> {
+/// One row: `method` drawn by `renderer` at `r`'s size in `t`, its step
+/// `(ms, sky s)`, its light grid's build and its state on the GPU.
+fn method_row(
+    (method, renderer): (&'static str, &'static str),
+    r: &RenderSettings,
+    p_covered: f64,
+    t: &FrameTimes,
+    (step_ms, step_s): (f64, f64),
+    light_grid_ms: f64,
+    state_bytes: usize,
+) -> MethodRow {
+    MethodRow {
+        method,
+        renderer,
+        width: r.width,
+        height: r.height,
+        p_covered,
+        median_ms: t.median(),
+        p95_ms: t.p95(),
+        timing: t.source(),
+        step_ms,
+        step_s,
+        light_grid_ms,
+        state_bytes,
+    }
+}
+
+/// One simulation step of `sc`'s method, born on `map`'s cells and spun
+/// up for the scene's `time_s` (at most 240 steps), ms and the sky
+/// seconds it advances.
+fn step_cost(sc: &Scene, map: &CloudMap, samples: usize) -> Result<(f64, f64), BenchError> {
     let atm = sc.atmosphere(None)?;
     let band = sc.band(&atm);
     let spin = Prepared::frames(sc).min(240);
     Ok(match sc.simulation.method {
         Method::Parcels | Method::Endless => {
             let mut sim = Simulation::new(sc.physics.clone(), atm);
-            let map = CloudMap::generate(&sc.render.cloud_map);
-            sim.set_spawn_sites(spawn_sites(&map, sc.physics.domain_size_m));
+            sim.set_spawn_sites(spawn_sites(map, sc.physics.domain_size_m));
             for _ in 0..spin {
                 sim.step();
             }
@@ -53,8 +83,7 @@ fn step_cost(sc: &Scene, samples: usize) -> Result<(f64, f64), BenchError> {
             )
         }
         Method::Automaton => {
-            let map = CloudMap::generate(&sc.render.cloud_map);
-            let sites = spawn_sites(&map, sc.physics.domain_size_m);
+            let sites = spawn_sites(map, sc.physics.domain_size_m);
             let mut a = Automaton::new(
                 &sc.simulation.automaton,
                 &sc.physics,
@@ -87,55 +116,42 @@ pub(super) fn compare_methods(
     let mut rows = Vec::new();
     let mut automaton = base.clone();
     automaton.simulation.method = Method::Automaton;
+    let mut parcels_covered = 0.0;
     for (sc, method) in [(base, "parcels"), (&automaton, "automaton")] {
         progress(&format!("methods: {method}, cloud map"));
         let p = Prepared::from_scene(sc, || {})?;
+        let covered = p.field.covered_fraction();
         let t = time_cloud_map(ctx, &p, r, o)?;
-        let (step_ms, step_s) = step_cost(sc, samples)?;
-        rows.push(MethodRow {
-            method,
-            renderer: "cloud_map",
-            width: r.width,
-            height: r.height,
-            p_covered: p.field.covered_fraction(),
-            median_ms: t.median(),
-            p95_ms: t.p95(),
-            timing: t.source(),
-            step_ms,
-            step_s,
-            light_grid_ms: 0.0,
-            state_bytes: field_texels(&p.field).len() * 2,
-        });
+        let step = step_cost(sc, &p.cloud_map, samples)?;
+        let p_bytes = field_texels(&p.field).len() * 2;
+        rows.push(method_row(
+            (method, "cloud_map"),
+            r,
+            covered,
+            &t,
+            step,
+            0.0,
+            p_bytes,
+        ));
         if sc.simulation.method == Method::Parcels {
             progress("methods: parcels, spheroids");
-            let ts = time_spheroids(ctx, &p, r, o)?;
-            let settings = p.gpu_settings(r, r.quality());
-            let mut s = SpheroidRenderer::new(
-                &ctx.device,
-                &ctx.queue,
-                crate::render::gpu::headless::TARGET_FORMAT,
-                &settings,
-            );
+            parcels_covered = covered;
+            let mut s = spheroid_renderer(ctx, &p, r);
+            s.resize(r.width, r.height);
+            let ts = time_pass(ctx, r, o, |e, v, c, q| s.render(e, v, c, q))?;
             let spheroids = p.spheroids();
             let grid_ms = median_ms(samples.min(5), || s.update_spheroids(&spheroids));
-            rows.push(MethodRow {
-                method,
-                renderer: "spheroids",
-                width: r.width,
-                height: r.height,
-                p_covered: p.field.covered_fraction(),
-                median_ms: ts.median(),
-                p95_ms: ts.p95(),
-                timing: ts.source(),
-                step_ms,
-                step_s,
-                light_grid_ms: grid_ms,
-                state_bytes: spheroids.len() * size_of::<crate::render::cpu::spheroids::Spheroid>()
-                    + 4 * (12
-                        + crate::render::cpu::spheroids::LIGHT_GRID_DIMS
-                            .iter()
-                            .product::<usize>()),
-            });
+            let bytes = spheroids.len() * size_of::<Spheroid>()
+                + 4 * (12 + LIGHT_GRID_DIMS.iter().product::<usize>());
+            rows.push(method_row(
+                (method, "spheroids"),
+                r,
+                covered,
+                &ts,
+                step,
+                grid_ms,
+                bytes,
+            ));
         }
     }
     progress("methods: endless volumes");
@@ -147,35 +163,35 @@ pub(super) fn compare_methods(
     let db = Database::build(base, &cfg, || {})?;
     let mut player = Player::new(&db, cfg.similarity, base.physics.seed);
     let (stack, params) = db.stack(player.at(0.0, db.interval_s));
-    let p = Prepared::from_scene(base, || {})?;
-    let t = time_volume(ctx, &p, r, o, &stack, params)?;
-    // One step picks the pair to show: far under a timer's resolution,
-    // so timed over a thousand.
+    let settings = db.gpu_settings(r);
+    let mut v = VolumeRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        TARGET_FORMAT,
+        &settings,
+        &stack,
+        params,
+    )?;
+    v.resize(r.width, r.height);
+    let t = time_pass(ctx, r, o, |e, view, c, q| v.render(e, view, c, q))?;
+    // Playback is stepped as often as the physics, for a like-for-like
+    // row; one step picks the pair to show, far under a timer's
+    // resolution, so it is timed over a thousand.
+    let dt = base.physics.dt_s;
     let step_ms = median_ms(samples, || {
         for k in 0..1000 {
-            std::hint::black_box(player.at(k as f64 * sc_step(base), db.interval_s));
+            std::hint::black_box(player.at(k as f64 * dt, db.interval_s));
         }
     }) / 1000.0;
-    rows.push(MethodRow {
-        method: "endless",
-        renderer: "volume",
-        width: r.width,
-        height: r.height,
-        p_covered: p.field.covered_fraction(),
-        median_ms: t.median(),
-        p95_ms: t.p95(),
-        timing: t.source(),
-        step_ms,
-        step_s: sc_step(base),
-        light_grid_ms: 0.0,
-        state_bytes: db.bytes(),
-    });
+    rows.push(method_row(
+        ("endless", "volume"),
+        r,
+        parcels_covered,
+        &t,
+        (step_ms, dt),
+        0.0,
+        db.bytes(),
+    ));
     let sweep = threshold_sweep(&db, &SIMILARITIES, 10_000, base.physics.seed);
     Ok((rows, sweep))
-}
-
-/// The sky seconds one physics step advances (the volumes' playback is
-/// stepped as often, for a like-for-like row).
-fn sc_step(sc: &Scene) -> f64 {
-    sc.physics.dt_s
 }

@@ -25,7 +25,7 @@ use crate::scene::{RenderSettings, Scene, SceneError};
 use methods::compare_methods;
 use physics_share::physics_in_frame;
 use quality::quality_sweep;
-use timing::{row, time_cloud_map, time_spheroids};
+use timing::{row, spheroid_renderer, time_cloud_map, time_pass};
 
 /// Errors of the benchmark.
 #[derive(Debug, thiserror::Error)]
@@ -330,7 +330,9 @@ pub fn run(
             rows.push(row("parcels", "per_parcel", r, &pn, None, 0));
         } else {
             progress(&format!("parcels {n}: spheroids"));
-            let tb = time_spheroids(ctx, &pn, r, o)?;
+            let mut sp = spheroid_renderer(ctx, &pn, r);
+            sp.resize(r.width, r.height);
+            let tb = time_pass(ctx, r, o, |e, v, c, q| sp.render(e, v, c, q))?;
             last_per_parcel = Some((n, tb.median()));
             rows.push(row("parcels", "per_parcel", r, &pn, Some(&tb), o.frames));
         }

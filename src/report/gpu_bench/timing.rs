@@ -3,6 +3,7 @@
 
 use super::{BenchOptions, Row};
 use crate::prepare::Prepared;
+use crate::render::camera::Camera;
 use crate::render::cpu::sky::SkyModel;
 use crate::render::gpu::headless::TARGET_FORMAT;
 use crate::render::gpu::spheroids::SpheroidRenderer;
@@ -46,52 +47,31 @@ pub(super) fn time_cloud_map(
     hl.time_frames(ctx, &r.camera(), o.warmup, o.frames)
 }
 
-/// Times the spheroid renderer on `p`'s parcels with `r`.
-pub(super) fn time_spheroids(
+/// The spheroid renderer of `p`'s parcels with `r`'s settings.
+pub(super) fn spheroid_renderer(
     ctx: &GpuContext,
     p: &Prepared,
     r: &RenderSettings,
-    o: &BenchOptions,
-) -> Result<FrameTimes, GpuError> {
+) -> SpheroidRenderer {
     let settings = p.gpu_settings(r, r.quality());
-    let mut b = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
-    b.update_spheroids(&p.spheroids());
-    b.resize(r.width, r.height);
-    let target = textures::create_2d(
-        &ctx.device,
-        "bench.target",
-        r.width,
-        r.height,
-        TARGET_FORMAT,
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-    );
-    let view = target.create_view(&Default::default());
-    let camera = r.camera();
-    time_frames(ctx, o.warmup, o.frames, |enc, q| {
-        b.render(enc, &view, &camera, q);
-        Ok(1)
-    })
+    let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+    s.update_spheroids(&p.spheroids());
+    s
 }
 
-/// Times the volume renderer of `stack` with `r`.
-pub(super) fn time_volume(
+/// Times a stand-alone pass (`draw` records one frame into the target
+/// from the camera) at `r`'s size.
+pub(super) fn time_pass(
     ctx: &GpuContext,
-    p: &Prepared,
     r: &RenderSettings,
     o: &BenchOptions,
-    stack: &crate::render::cpu::volume::VolumeStack,
-    params: crate::render::cpu::volume::VolumeParams,
+    mut draw: impl FnMut(
+        &mut wgpu::CommandEncoder,
+        &wgpu::TextureView,
+        &Camera,
+        Option<&wgpu::QuerySet>,
+    ),
 ) -> Result<FrameTimes, GpuError> {
-    let settings = p.gpu_settings(r, r.quality());
-    let mut v = crate::render::gpu::volume_pass::VolumeRenderer::new(
-        &ctx.device,
-        &ctx.queue,
-        TARGET_FORMAT,
-        &settings,
-        stack,
-        params,
-    )?;
-    v.resize(r.width, r.height);
     let target = textures::create_2d(
         &ctx.device,
         "bench.target",
@@ -103,7 +83,7 @@ pub(super) fn time_volume(
     let view = target.create_view(&Default::default());
     let camera = r.camera();
     time_frames(ctx, o.warmup, o.frames, |enc, q| {
-        v.render(enc, &view, &camera, q);
+        draw(enc, &view, &camera, q);
         Ok(1)
     })
 }
