@@ -5,11 +5,13 @@ use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::density::{
     BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
 };
-use cumulus::render::cpu::lighting::sun_transmittance;
+use cumulus::render::cpu::lighting::{phase_dual, sun_transmittance};
 use cumulus::render::cpu::renderer::{
-    Frame, Quality, flat_ground_shadow, march_ray, render_linear, sea_reflection, to_srgb8,
+    ALBEDO, Frame, Quality, flat_ground_shadow, march_ray, render_linear, sea_reflection, to_srgb8,
 };
-use cumulus::render::cpu::sky::{AtmosphereConfig, SkyModel, background_radiance, sun_direction};
+use cumulus::render::cpu::sky::{
+    AtmosphereConfig, SkyModel, background_radiance, sun_direction, sun_light_at,
+};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
 
@@ -253,6 +255,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
                 model: SkyModel::Analytic,
                 ..AtmosphereConfig::default()
             },
+            single_scattering: false,
         },
         terrain: None,
         sky: None,
@@ -263,6 +266,31 @@ fn constant_slab_transmittance_matches_beer_lambert() {
         (s.transmittance - expected).abs() / expected < BEER_LAMBERT_TOLERANCE,
         "{} vs {expected}",
         s.transmittance
+    );
+    // The sun's light scattered once, with no shadow ray (the sun
+    // unattenuated inside the slab): the same in-scattered light at every
+    // sample, so the radiance is that light times the opacity, exactly
+    // (the steps' `integrate_step` telescopes), and no sky, ground or
+    // background light is added.
+    let single = Frame {
+        quality: Quality {
+            single_scattering: true,
+            ..frame.quality
+        },
+        ..frame
+    };
+    let s1 = march_ray(origin, Vec3::Y, 0.5, 0.0, &single);
+    let sun_dir = sun_direction(60.0, 0.0);
+    let sun = sun_light_at(
+        &single.sky_light(),
+        0.5 * (d.band_bottom_m + d.band_top_m),
+        sun_dir,
+    );
+    let once = sun * (phase_dual(sun_dir.y, 1.0) * ALBEDO * (1.0 - s1.transmittance));
+    assert!(
+        (s1.radiance - once).abs().max_element() <= 1e-3 * once.max_element(),
+        "{} vs {once}",
+        s1.radiance
     );
 }
 
@@ -291,6 +319,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
                 model: SkyModel::Analytic,
                 ..AtmosphereConfig::default()
             },
+            single_scattering: false,
         },
         terrain: None,
         sky: None,

@@ -65,8 +65,9 @@ pub struct RenderSettings {
     pub steps: u32,
     /// Shadow march steps toward the sun (0..=64; 0 = off). Default 20:
     /// fewer, longer steps miss small wisps and leak light (against the
-    /// path tracer, backlit clouds are +7 % too bright at 20, +11 % at 16,
-    /// +23 % at 12; docs/ground_truth).
+    /// path tracer, the full backlit picture is +7 % too bright at 20,
+    /// +11 % at 16, +23 % at 12; its single scattering alone +31 % at 20,
+    /// +12 % at 32, +7 % at 48; docs/ground_truth).
     pub shadow_steps: u32,
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
     /// (the octaves were fitted to the path tracer with 3).
@@ -378,6 +379,7 @@ impl RenderSettings {
             exposure: self.exposure,
             sea_wind_mps: self.ground.sea_wind_mps(),
             atmosphere: self.atmosphere,
+            single_scattering: false,
         }
     }
 }

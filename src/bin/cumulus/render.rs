@@ -60,6 +60,13 @@ pub struct RenderArgs {
     /// adapter has them, else CPU wall time (labelled).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100000))]
     time_frames: Option<u32>,
+    /// CPU, cloud map only: render the sun's light scattered once and
+    /// nothing else (no multiple-scattering octaves, no sky or ground
+    /// light in the clouds, black behind them, no haze): the part of the
+    /// light a path tracer limited to one scattering checks exactly
+    /// (docs/ground_truth/compare.py --single-scattering).
+    #[arg(long)]
+    single_scattering: bool,
 }
 
 /// What `--out` holds, from its extension.
@@ -96,7 +103,7 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::renderer::render_linear_offsets;
+    use cumulus::render::cpu::renderer::{Quality, render_linear_offsets};
     use cumulus::report::render_quality;
 
     let flags = [
@@ -150,6 +157,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if gpu.is_none() && a.time_frames.is_some() {
         bail!("--time-frames needs the GPU backend (--backend gpu)");
     }
+    if a.single_scattering
+        && (gpu.is_some()
+            || scene.simulation.method == Method::Endless
+            || scene.render.renderer == RenderMethod::Spheroids)
+    {
+        bail!(
+            "--single-scattering is a check of the CPU reference's cloud-map renderer: \
+             use --backend cpu with render.renderer = \"cloud_map\" and a simulated (not endless) scene"
+        );
+    }
     if scene.simulation.method == Method::Endless {
         return render_endless(gpu.as_ref(), &a, &scene, picture);
     }
@@ -157,7 +174,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
     let r = &scene.render;
-    let frame = prepared.frame(r, r.quality());
+    let quality = Quality {
+        single_scattering: a.single_scattering,
+        ..r.quality()
+    };
+    let frame = prepared.frame(r, quality);
     if let Some(dir) = &a.quality_report {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create directory", dir.display()))?;
@@ -224,13 +245,17 @@ pub fn run(a: RenderArgs) -> Result<()> {
 
     write_linear(out, picture, r, &linear)?;
     eprintln!(
-        "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {} octaves; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
         r.height,
         elapsed.as_secs_f64(),
         r.steps,
         r.shadow_steps,
-        r.octaves,
+        if a.single_scattering {
+            "single scattering only".to_string()
+        } else {
+            format!("{} octaves", r.octaves)
+        },
         100.0 * prepared.field.covered_fraction(),
         prepared.band.bottom_m,
         prepared.band.top_m,

@@ -40,6 +40,12 @@ pub struct Quality {
     pub sea_wind_mps: Option<f32>,
     /// The sky model and aerial perspective (`[render.atmosphere]`).
     pub atmosphere: AtmosphereConfig,
+    /// Only the sun's light scattered once: no octaves, no sky or ground
+    /// light in the clouds, nothing behind them (black) and no haze in
+    /// front; what a path tracer limited to one scattering renders
+    /// (`cumulus render --single-scattering`, docs/ground_truth). Scenes
+    /// never set it.
+    pub single_scattering: bool,
 }
 
 /// Single-scattering albedo of cloud droplets.
@@ -169,6 +175,11 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             q.max_distance_m,
         ),
     };
+    let background = if q.single_scattering {
+        Vec3::ZERO
+    } else {
+        background
+    };
     let Some((t0, t1)) = band_segment(origin, dir, d.band_bottom_m, d.band_top_m, max_t) else {
         return RaySample {
             radiance: background,
@@ -219,8 +230,12 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
             // Sky light from above, darker toward the cloud base, and the
             // ground's from below.
-            let ambient = ambient_light(sky_top, ground, eta);
-            let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, q.octaves) + ambient;
+            let (ambient, octaves) = if q.single_scattering {
+                (Vec3::ZERO, 0)
+            } else {
+                (ambient_light(sky_top, ground, eta), q.octaves)
+            };
+            let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, octaves) + ambient;
             let s = scatter * (sigma_t * ALBEDO);
             let step_t = (-sigma_t * h).exp();
             light += integrate_step(s, sigma_t, h) * transmittance;
@@ -239,7 +254,11 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
         0.0
     };
     let (inscatter, haze) = aerial(sky, dir, cloud_distance, sun_dir);
-    let clouds = light * haze + inscatter * opacity;
+    let clouds = if q.single_scattering {
+        light
+    } else {
+        light * haze + inscatter * opacity
+    };
     RaySample {
         radiance: clouds + background * transmittance,
         clouds,
