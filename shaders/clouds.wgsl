@@ -61,7 +61,7 @@ const REFLECTION_SHADOW_STEPS: u32 = 4u;
 // The clip depth at which rays are unprojected.
 const RAY_DEPTH: f32 = 0.5;
 
-// Mirrors `FrameUniforms` in src/render/gpu/uniforms.rs (448 bytes). The
+// Mirrors `FrameUniforms` in src/render/gpu/uniforms.rs (432 bytes). The
 // camera is `View`'s (src/render/camera.rs): any perspective projection,
 // standard or reversed depth.
 struct Frame {
@@ -69,8 +69,7 @@ struct Frame {
     screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
-    ambient_top: vec4f,  // unused (xyz: the analytic sky_above(up) / 4), exposure
-    sky_up: vec4f,       // unused (xyz: the analytic sky_above(up), w: 0)
+    exposure: vec4f,     // exposure before the tone map, unused, unused, unused
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend

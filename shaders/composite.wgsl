@@ -29,7 +29,7 @@ fn display(c: vec3f) -> vec3f {
     if !TONE_MAP {
         return max(c, vec3f(0.0));
     }
-    let m = tone_map(c, frame.ambient_top.w);
+    let m = tone_map(c, frame.exposure.x);
     if ENCODE_SRGB {
         return vec3f(srgb_encode(m.x), srgb_encode(m.y), srgb_encode(m.z));
     }

@@ -246,8 +246,8 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
     macro_rules! offsets {
         ($t:ty: $($f:ident),*) => { [$((stringify!($f), offset_of!($t, $f))),*] };
     }
-    let rust = offsets!(FrameUniforms: cam_pos, screen, sun_dir, sun_light, ambient_top,
-        sky_up, band, map, jitter, terrain, counts, mask, view_proj, prev_view_proj,
+    let rust = offsets!(FrameUniforms: cam_pos, screen, sun_dir, sun_light, exposure,
+        band, map, jitter, terrain, counts, mask, view_proj, prev_view_proj,
         inverse_projection, view_to_world);
     same_layout("Frame", &rust, size_of::<FrameUniforms>());
     let rust = offsets!(Spheroid: centre_radius, shape);

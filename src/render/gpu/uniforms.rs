@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 use crate::render::camera::View;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::renderer::{Quality, SUN_INTENSITY};
-use crate::render::cpu::sky::{analytic_sky, sun_color, sun_direction};
+use crate::render::cpu::sky::{sun_color, sun_direction};
 use crate::render::cpu::sky_luts::SkyParams;
 #[cfg(doc)]
 use crate::render::cpu::sky_luts::radius_at_altitude;
@@ -21,8 +21,7 @@ pub struct FrameUniforms {
     pub screen: [f32; 4],
     pub sun_dir: [f32; 4],
     pub sun_light: [f32; 4],
-    pub ambient_top: [f32; 4],
-    pub sky_up: [f32; 4],
+    pub exposure: [f32; 4],
     pub band: [f32; 4],
     pub map: [f32; 4],
     pub jitter: [f32; 4],
@@ -35,7 +34,7 @@ pub struct FrameUniforms {
     pub view_to_world: [[f32; 4]; 4],
 }
 
-const _: () = assert!(size_of::<FrameUniforms>() == 448);
+const _: () = assert!(size_of::<FrameUniforms>() == 432);
 
 /// The per-frame inputs of [`FrameUniforms::new`].
 #[derive(Debug, Clone, Copy)]
@@ -68,15 +67,12 @@ pub struct FrameInputs {
 }
 
 impl FrameUniforms {
-    /// Fills the block; the analytic sky's per-frame constants (sun
-    /// colour, zenith) are computed here once instead of per pixel (the
-    /// physical sky reads its tables).
+    /// Fills the block; the analytic sky's sun colour is computed here
+    /// once instead of per pixel (the physical sky reads its tables).
     pub fn new(i: &FrameInputs) -> Self {
         let (w, h) = (i.width.max(1) as f32, i.height.max(1) as f32);
         let sun_dir = sun_direction(i.sun_elevation_deg, i.sun_azimuth_deg);
         let sun = sun_color(sun_dir) * SUN_INTENSITY;
-        let sky_up = analytic_sky(Vec3::Y, sun_dir);
-        let ambient = sky_up * 0.25;
         let q = &i.quality;
         let d = &i.density;
         let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
@@ -90,8 +86,7 @@ impl FrameUniforms {
             ],
             sun_dir: v4(sun_dir, q.haze_distance_m),
             sun_light: v4(sun, q.max_distance_m),
-            ambient_top: v4(ambient, q.exposure),
-            sky_up: v4(sky_up, 0.0),
+            exposure: [q.exposure, 0.0, 0.0, 0.0],
             band: [
                 d.band_bottom_m,
                 d.band_top_m,
