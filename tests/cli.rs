@@ -926,3 +926,67 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
         b"not volumes"
     );
 }
+
+/// `render --single-scattering`: the sun's once-scattered light alone, so
+/// where no cloud is the picture is black (the sky behind is left out);
+/// refused with a clear error for what it does not cover (the spheroid
+/// renderer here), before anything is simulated or written.
+#[test]
+fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = root().join("scenes/fair_weather.toml");
+    let render = |name: &str, single: bool| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--backend",
+            "cpu",
+        ];
+        if single {
+            args.push("--single-scattering");
+        }
+        let o = cumulus(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        image::open(out).unwrap().to_rgb8()
+    };
+    let black = |img: &image::RgbImage| img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
+    let (full, single) = (render("full.png", false), render("single.png", true));
+    assert_eq!(black(&full), 0, "the full picture has its sky");
+    assert!(
+        black(&single) > 200,
+        "the sky is left out: {} black pixels of {}",
+        black(&single),
+        48 * 36
+    );
+    assert!(
+        black(&single) < 48 * 36,
+        "the clouds' once-scattered light is there"
+    );
+
+    let out = dir.path().join("spheroids.png");
+    let o = cumulus(&[
+        "render",
+        "--scene",
+        root().join("scenes/spheroids.toml").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--backend",
+        "cpu",
+        "--single-scattering",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("--single-scattering") && stderr(&o).contains("cloud_map"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+}
