@@ -47,12 +47,15 @@ const WATER_F0: f32 = 0.0204;
 // The longest shadow ray toward the sun, m.
 const SHADOW_RAY_M: f32 = 2000.0;
 // Multiple scattering and sky light (the CPU's lighting.rs, renderer.rs).
-const OCTAVE_SCATTERING: f32 = 0.67;
-const OCTAVE_EXTINCTION: f32 = 0.32;
-const OCTAVE_ECCENTRICITY: f32 = 0.55;
-const MULTIPLE_GAIN: f32 = 1.1;
+const OCTAVE_SCATTERING: f32 = 0.5;
+const OCTAVE_EXTINCTION: f32 = 0.5;
+const OCTAVE_ECCENTRICITY: f32 = 0.8;
+const MULTIPLE_GAIN: f32 = 0.77;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.47;
 const MULTIPLE_SUN_POWER: f32 = 0.4;
-const AMBIENT_GAIN: f32 = 1.4;
+const DIFFUSE_GAIN: f32 = 1.03;
+const DIFFUSE_DEPTH_M: f32 = 100.0;
+const AMBIENT_GAIN: f32 = 2.12;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
 // Uniform steps of a ray the sea reflects, and its shadow samples.
@@ -353,11 +356,23 @@ fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
     return min(to_top, SHADOW_RAY_M);
 }
 
-// Single scattering and OCTAVES octaves of multiple scattering (the CPU's
-// `sun_scattering`; constants fitted to the path tracer, docs/ground_truth).
-fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32) -> f32 {
+// The sunlight diffused through the cloud layer, per unit scattering
+// coefficient, in cloud of extinction `sigma_t` (the CPU's `diffused_sun`).
+fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
+    return DIFFUSE_GAIN * max(mu_sun, 0.0) * (1.0 - exp(-sigma_t * DIFFUSE_DEPTH_M)) / (4.0 * PI);
+}
+
+// Single scattering and, when OCTAVES > 0, OCTAVES octaves of multiple
+// scattering (forward and isotropic parts) and the diffused sunlight
+// (the CPU's `sun_scattering`; gains fitted to the path tracer,
+// docs/ground_truth).
+fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32, sigma_t: f32) -> f32 {
     var sum = phase_dual(cos_theta, 1.0) * exp(-tau_sun);
-    let gain = MULTIPLE_GAIN * pow(max(mu_sun, 0.0), MULTIPLE_SUN_POWER);
+    if OCTAVES == 0u {
+        return sum;
+    }
+    let height = pow(max(mu_sun, 0.0), MULTIPLE_SUN_POWER);
+    let isotropic = MULTIPLE_ISOTROPIC_GAIN / (4.0 * PI);
     var a = 1.0;
     var b = 1.0;
     var c = 1.0;
@@ -365,9 +380,10 @@ fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32) -> f32 {
         a *= OCTAVE_SCATTERING;
         b *= OCTAVE_EXTINCTION;
         c *= OCTAVE_ECCENTRICITY;
-        sum += gain * a * phase_dual(cos_theta, c) * exp(-b * tau_sun);
+        let phase = MULTIPLE_GAIN * phase_dual(cos_theta, c) + isotropic;
+        sum += height * a * phase * exp(-b * tau_sun);
     }
-    return sum;
+    return sum + diffused_sun(mu_sun, sigma_t);
 }
 
 // The sky's and the ground's light scattered at height fraction `eta`
@@ -514,7 +530,7 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
         let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS);
         let tau_sun = -log(max(shadow, 1e-30));
         let eta = clamp((x.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let scatter = sun * sun_scattering(tau_sun, cos_theta, sun_dir.y) + ambient_light(sky_top, ground, eta);
+        let scatter = sun * sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + ambient_light(sky_top, ground, eta);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= exp(-sigma_t * h);
         if transmittance < MIN_TRANSMITTANCE {
@@ -684,7 +700,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 lit = false;
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
                 let ambient = ambient_light(sky_top, ground, eta);
-                let scatter = sun * sun_scattering(tau, cos_theta, sun_dir.y) + ambient;
+                let scatter = sun * sun_scattering(tau, cos_theta, sun_dir.y, lit_sigma) + ambient;
                 let s = scatter * (lit_sigma * ALBEDO);
                 let step_t = exp(-lit_sigma * h);
                 light += integrate_step(s, lit_sigma, h) * transmittance;

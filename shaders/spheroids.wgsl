@@ -234,7 +234,7 @@ fn march_spheroids(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
         let tau_sun = light_grid_depth(p);
         let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
         let ambient = ambient_light(sky_top, ground, eta);
-        let src = (sun * sun_scattering(tau_sun, cos_theta, sun_dir.y) + ambient) * (sigma_t * ALBEDO);
+        let src = (sun * sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + ambient) * (sigma_t * ALBEDO);
         let step_t = exp(-sigma_t * dt);
         light += integrate_step(src, sigma_t, dt) * transmittance;
         depth_weighted += t * transmittance * (1.0 - step_t);

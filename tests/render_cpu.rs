@@ -329,7 +329,10 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
 #[test]
 fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
     let cm = cloud_map();
-    let p = ProjectedField::uniform(32, 32, [1.0, 0.8, 1.0]);
+    // Coverage 0.7: a sky with gaps between clouds. (At full coverage the
+    // map leaves almost none, and the pixels counted as sky were thin
+    // cloud over it, which the diffused sunlight now whitens.)
+    let p = ProjectedField::uniform(32, 32, [0.7, 0.8, 1.0]);
     let fr = small_frame(&p, &cm);
     let img = render_linear(96, 64, &fr);
     assert!(img.iter().all(|c| c.is_finite()));

@@ -76,7 +76,13 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("OCTAVE_EXTINCTION", lighting::OCTAVE_EXTINCTION as f64),
         ("OCTAVE_ECCENTRICITY", lighting::OCTAVE_ECCENTRICITY as f64),
         ("MULTIPLE_GAIN", lighting::MULTIPLE_GAIN as f64),
+        (
+            "MULTIPLE_ISOTROPIC_GAIN",
+            lighting::MULTIPLE_ISOTROPIC_GAIN as f64,
+        ),
         ("MULTIPLE_SUN_POWER", lighting::MULTIPLE_SUN_POWER as f64),
+        ("DIFFUSE_GAIN", lighting::DIFFUSE_GAIN as f64),
+        ("DIFFUSE_DEPTH_M", lighting::DIFFUSE_DEPTH_M as f64),
         ("AMBIENT_GAIN", renderer::AMBIENT_GAIN as f64),
         ("GROUND_SHADOW_STEPS", renderer::GROUND_SHADOW_STEPS as f64),
         ("RAY_DEPTH", cumulus::render::camera::RAY_DEPTH as f64),

@@ -14,12 +14,15 @@ Writes into docs/ground_truth/: VIEW_side_by_side.png (ours | Mitsuba |
 relative luminance error), ground_truth.csv (one row per view) and prints
 the table the README quotes. Uses Mitsuba's `llvm_ad_rgb` variant (CPU).
 
-The views look up from the middle of the simulated domain at 40° (a 40°
-field of view), so every ray leaves the cloud band inside the exported box
-(the renderer's sky repeats the domain around it; the box holds one copy).
-Cloud pixels are those whose optical depth through the exported grid is at
-least 1 (computed here by marching the grid, independently of both
-renderers).
+Three views look up from the middle of the simulated domain at 40° (a
+40° field of view), so every ray leaves the cloud band inside the exported
+box (the renderer's sky repeats the domain around it; the box holds one
+copy). The fourth, `side`, stands at the box's southern edge and looks
+north at 25°, across the domain, at clouds lit from the right: their
+sunlit and shadowed sides. Cloud pixels are those whose optical depth
+through the exported grid is at least 1 (3 for `side`, whose low rays
+leave the box through its far side, beyond which ours has more clouds;
+computed here by marching the grid, independently of both renderers).
 
 The metric, per view, over the cloud pixels: the mean of |Y_ours - Y_mi| /
 Y_mi for the luminance Y, the same over 4x4-pixel blocks wholly of cloud
@@ -67,7 +70,13 @@ VIEWS = [
     ("high_sun", "fair_weather", 60.0, 110.0, 20.0),
     ("low_sun", "fair_weather", 8.0, 290.0, 20.0),
     ("backlit", "fair_weather", 25.0, 20.0, 20.0),
+    ("side", "fair_weather", 35.0, 90.0, 0.0),
 ]
+
+# Views whose camera is not the default one ([render] keys), and their
+# least optical depth for a cloud pixel (default 1).
+VIEW_CAMERA = {"side": {"camera_position_m": "[5000.0, 120.0, 150.0]", "camera_pitch_deg": "25.0"}}
+VIEW_TAU_MIN = {"side": 3.0}
 
 
 def scene_variant(base, sun_el, sun_az, yaw, width, height, path, extra=()):
@@ -278,7 +287,8 @@ def main():
         for name, base, sun_el, sun_az, yaw in views:
             scene = os.path.join(ROOT, "scenes", f".gt_{name}_{os.getpid()}.toml")
             ss = max(1, a.supersample)
-            scene_variant(base, sun_el, sun_az, yaw, a.width * ss, a.height * ss, scene, extra)
+            scene_variant(base, sun_el, sun_az, yaw, a.width * ss, a.height * ss, scene,
+                          {**VIEW_CAMERA.get(name, {}), **extra})
             try:
                 vol, sky = os.path.join(tmp, f"{name}.vol"), os.path.join(tmp, f"{name}_sky.exr")
                 ours_path = os.path.join(tmp, f"{name}_ours.exr")
@@ -313,7 +323,7 @@ def main():
             sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
             near_sun = np.degrees(np.arccos(np.clip(dirs @ sun, -1, 1))) < (
                 SUN_RADIUS_DEG + np.sqrt(2) * side["camera_fov_y_deg"] / a.height)
-            cloud = (tau >= 1.0) & ~near_sun
+            cloud = (tau >= VIEW_TAU_MIN.get(name, 1.0)) & ~near_sun
             yo, ym = luminance(ours), luminance(truth)
             rel = (yo - ym) / np.maximum(ym, 1e-6)
             n = int(cloud.sum())

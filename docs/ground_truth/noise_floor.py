@@ -38,7 +38,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for name, base, el, az, yaw in C.VIEWS:
             scene = os.path.join(C.ROOT, "scenes", f".floor_{name}.toml")
-            C.scene_variant(base, el, az, yaw, a.width, a.height, scene)
+            C.scene_variant(base, el, az, yaw, a.width, a.height, scene, C.VIEW_CAMERA.get(name, {}))
             vol, sky = os.path.join(tmp, f"{name}.vol"), os.path.join(tmp, f"{name}_sky.exr")
             try:
                 subprocess.run([a.bin, "export", "--scene", scene, "--out", vol, "--sky", sky],
@@ -52,7 +52,7 @@ def main():
                 renders.append(C.mitsuba_render(vol, sky, side, a.spp, a.width, a.height))
             mi.render = render
             eye, dirs = C.camera_rays(side, a.width, a.height)
-            cloud = C.optical_depth(C.read_vol(vol), side, eye, dirs) >= 1.0
+            cloud = C.optical_depth(C.read_vol(vol), side, eye, dirs) >= C.VIEW_TAU_MIN.get(name, 1.0)
             y1, y2 = C.luminance(renders[1]), C.luminance(renders[0])
             rel = (y1 - y2) / np.maximum(y2, 1e-6)
             bh, bw = a.height // 4, a.width // 4

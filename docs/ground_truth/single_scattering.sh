@@ -16,7 +16,8 @@ trap 'rm -rf "$OUT"' EXIT
 for n in $STEPS; do
   mkdir -p "$OUT/$n"
   python3 "$HERE/compare.py" --width 80 --height 60 --spp "$SPP" --cells 512 --supersample 4 \
-    --single-scattering --set "shadow_steps=$n" --cache "$CACHE" --out "$OUT/$n"
+    --single-scattering --set "shadow_steps=$n" --cache "$CACHE" --out "$OUT/$n" \
+    --views high_sun,low_sun,backlit
 done
 python3 - "$OUT" "$HERE" $STEPS <<'PY'
 import csv, os, shutil, sys

@@ -70,7 +70,8 @@ pub struct RenderSettings {
     /// +12 % at 32, +7 % at 48; docs/ground_truth).
     pub shadow_steps: u32,
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
-    /// (the octaves were fitted to the path tracer with 3).
+    /// (the light was fitted to the path tracer with 3). 0 turns multiple
+    /// scattering off, the sunlight diffused through the layer with it.
     pub octaves: u32,
     /// The analytic sky's aerial-perspective distance, m (> 0). Default
     /// 25000 (the physical sky's haze comes from its air,

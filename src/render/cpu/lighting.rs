@@ -101,46 +101,92 @@ pub fn sun_transmittance(
 }
 
 /// Per octave of multiple scattering, the factor on the scattered light
-/// (Wrenninge 2013's `a`; `OCTAVE_SCATTERING` in WGSL).
-pub const OCTAVE_SCATTERING: f32 = 0.67;
-/// Per octave, the factor on the optical depth toward the sun (`b`): the
-/// light of later octaves has diffused around what blocks the direct beam.
-pub const OCTAVE_EXTINCTION: f32 = 0.32;
+/// (Wrenninge 2013's `a`, his value; `OCTAVE_SCATTERING` in WGSL).
+pub const OCTAVE_SCATTERING: f32 = 0.5;
+/// Per octave, the factor on the optical depth toward the sun (`b`,
+/// Wrenninge's value): the light of later octaves has diffused around
+/// what blocks the direct beam.
+pub const OCTAVE_EXTINCTION: f32 = 0.5;
 /// Per octave, the factor on the phase function's eccentricity (`c`):
-/// multiply scattered light forgets the sun's direction.
-pub const OCTAVE_ECCENTRICITY: f32 = 0.55;
-/// The multiple-scattering octaves' gain at a sun in the zenith.
-pub const MULTIPLE_GAIN: f32 = 1.1;
-/// The octaves scale with the sun's height as `sin(elevation)^MULTIPLE_SUN_POWER`:
-/// the light that a layer of cloud takes in, and so diffuses, is the sun's
-/// flux through its horizontal extent, which falls with the sun.
+/// light scattered `n` times by a Henyey-Greenstein lobe of asymmetry
+/// `g` keeps `g^n` of it, and the forward lobe's `g` is 0.8, so 0.8.
+pub const OCTAVE_ECCENTRICITY: f32 = 0.8;
+/// The gain on the octaves' forward-scattered light (the phase
+/// function's lobes at the octave's eccentricity) at a sun in the zenith
+/// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`] and the
+/// ambient's gain are; docs/ground_truth).
+pub const MULTIPLE_GAIN: f32 = 0.77;
+/// The gain on the octaves' isotropic light: light scattered many times
+/// leaves a cloud in every direction, not only in the phase's lobes (a
+/// side view of a cloud is a quarter darker without it).
+pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.47;
+/// The octaves scale with the sun's height as `sin(elevation)^MULTIPLE_SUN_POWER`.
 pub const MULTIPLE_SUN_POWER: f32 = 0.4;
+/// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
+/// zenith.
+pub const DIFFUSE_GAIN: f32 = 1.03;
+/// A sample carries the diffused sunlight in proportion to its opacity
+/// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
+/// cloud, not the thin haze and wisps between clouds, which have little
+/// cloud around them to diffuse the light.
+pub const DIFFUSE_DEPTH_M: f32 = 100.0;
 
-/// Sun light scattered toward the eye per unit scattering coefficient:
-/// single scattering (`phase_dual` through the optical depth `tau_sun`)
-/// and `octaves` octaves of multiple scattering (Wrenninge 2013: octave
-/// `i` scatters `a^i` of the light through `b^i` of the optical depth with
-/// `c^i` of the eccentricity), the octaves weighted by [`MULTIPLE_GAIN`]
-/// and the sun's height `mu_sun` (`sin` of its elevation) to the power
-/// [`MULTIPLE_SUN_POWER`].
+/// The sunlight diffused through the cloud layer, per unit scattering
+/// coefficient and per unit sun irradiance, in cloud of extinction
+/// `sigma_t`, under a sun of height `mu_sun` (`sin` of its elevation).
 ///
-/// The five constants were fitted to Mitsuba 3's volumetric path tracer
-/// (all orders of scattering) on three views, a high sun, a low sun and a
-/// backlit view, with the ambient's [`super::renderer::AMBIENT_GAIN`]
-/// (docs/ground_truth). With Wrenninge's halving (`a = b = c = 0.5`)
-/// deep cloud under a high sun was half as bright as the path tracer's.
+/// Sunlight that enters a deep layer of cloud is scattered hundreds of
+/// times and spreads through it, in every direction: what the layer
+/// takes in, and so what fills it, is the sun's flux through its
+/// horizontal extent, `E · sin(elevation)`, scattered isotropically. It
+/// does not depend on the sun's shadow ray: the path tracer's light in
+/// deep cloud rises with the depth the camera sees, and a term of the
+/// shadow ray alone, as the octaves are, falls with it (docs/ground_truth).
 #[inline]
-pub fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32, octaves: u32) -> f32 {
+pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
+    DIFFUSE_GAIN * mu_sun.max(0.0) * (1.0 - (-sigma_t * DIFFUSE_DEPTH_M).exp()) / (4.0 * PI)
+}
+
+/// Sun light scattered toward the eye per unit scattering coefficient in
+/// cloud of extinction `sigma_t`: single scattering (`phase_dual`
+/// through the optical depth `tau_sun`) and, when `octaves > 0`, multiple
+/// scattering: `octaves` octaves (Wrenninge 2013: octave `i` scatters
+/// `a^i` of the light through `b^i` of the optical depth), each as a
+/// forward part (the phase with `c^i` of the eccentricity, times
+/// [`MULTIPLE_GAIN`]) and an isotropic part ([`MULTIPLE_ISOTROPIC_GAIN`]),
+/// scaled by the sun's height `mu_sun` (`sin` of its elevation) to the
+/// power [`MULTIPLE_SUN_POWER`]; and the sunlight diffused through the
+/// layer ([`diffused_sun`]).
+///
+/// The four gains (the octaves' two, the diffused light's and the
+/// ambient's [`super::renderer::AMBIENT_GAIN`]) were fitted to Mitsuba
+/// 3's volumetric path tracer (all orders of scattering) on four views: a
+/// high sun, a low sun, a backlit view and a side view (docs/ground_truth,
+/// `surrogate.py`). Forward octaves alone, however fitted, left 18-21 %
+/// per pixel: they dim deep cloud, where the path tracer's light stays.
+#[inline]
+pub fn sun_scattering(
+    tau_sun: f32,
+    cos_theta: f32,
+    mu_sun: f32,
+    sigma_t: f32,
+    octaves: u32,
+) -> f32 {
     let mut sum = phase_dual(cos_theta, 1.0) * (-tau_sun).exp();
-    let gain = MULTIPLE_GAIN * mu_sun.max(0.0).powf(MULTIPLE_SUN_POWER);
+    if octaves == 0 {
+        return sum;
+    }
+    let height = mu_sun.max(0.0).powf(MULTIPLE_SUN_POWER);
+    let isotropic = MULTIPLE_ISOTROPIC_GAIN / (4.0 * PI);
     let (mut a, mut b, mut c) = (1.0, 1.0, 1.0);
     for _ in 0..octaves {
         a *= OCTAVE_SCATTERING;
         b *= OCTAVE_EXTINCTION;
         c *= OCTAVE_ECCENTRICITY;
-        sum += gain * a * phase_dual(cos_theta, c) * (-b * tau_sun).exp();
+        let phase = MULTIPLE_GAIN * phase_dual(cos_theta, c) + isotropic;
+        sum += height * a * phase * (-b * tau_sun).exp();
     }
-    sum
+    sum + diffused_sun(mu_sun, sigma_t)
 }
 
 /// Energy-conserving integral of in-scattered light `s` over a step of
@@ -171,6 +217,48 @@ mod tests {
                 .sum();
             assert!((s - 1.0).abs() < 2e-3, "g={g}: {s}");
         }
+    }
+
+    #[test]
+    fn deep_cloud_keeps_the_diffused_sunlight() {
+        // Far behind its sunlit skin (tau 200), a point in dense cloud
+        // still holds the light diffused through the layer: the octaves
+        // are gone (e^{-0.125 * 200}), the diffused light is not.
+        let (cos, mu, sigma) = (0.3, 0.8, 0.03);
+        let deep = sun_scattering(200.0, cos, mu, sigma, 3);
+        let expected = DIFFUSE_GAIN * mu / (4.0 * PI);
+        assert!(
+            deep > 0.9 * expected && deep < 1.01 * expected,
+            "{deep} vs {expected}"
+        );
+        // It scales with the sun's flux through the layer, sin(elevation),
+        // and is the same in every direction.
+        let low = sun_scattering(200.0, cos, 0.2, sigma, 3);
+        assert!((low / deep - 0.25).abs() < 0.02, "{low} / {deep}");
+        assert_eq!(deep, sun_scattering(200.0, -0.9, mu, sigma, 3));
+        // Thin haze carries little of it; a sun below the horizon none.
+        assert!(diffused_sun(mu, 1e-4) < 0.02 * diffused_sun(mu, sigma));
+        assert_eq!(diffused_sun(-0.1, sigma), 0.0);
+        // No octaves: single scattering alone, nothing diffused.
+        let single = sun_scattering(2.0, cos, mu, sigma, 0);
+        assert_eq!(single, phase_dual(cos, 1.0) * (-2.0_f32).exp());
+    }
+
+    #[test]
+    fn octaves_scatter_sideways_as_well_as_forward() {
+        // Near the sunlit skin, multiply scattered light leaves sideways
+        // (cos 0) at least the isotropic part's share, not only what the
+        // forward lobes send there.
+        let (mu, sigma) = (1.0, 0.03);
+        let side = sun_scattering(0.0, 0.0, mu, sigma, 3) - sun_scattering(0.0, 0.0, mu, sigma, 0);
+        let iso: f32 = (1..=3).map(|i| OCTAVE_SCATTERING.powi(i)).sum::<f32>()
+            * MULTIPLE_ISOTROPIC_GAIN
+            / (4.0 * PI);
+        assert!(side > iso + diffused_sun(mu, sigma), "{side} vs {iso}");
+        // Toward the sun the forward lobes add far more.
+        let forward =
+            sun_scattering(0.0, 0.99, mu, sigma, 3) - sun_scattering(0.0, 0.99, mu, sigma, 0);
+        assert!(forward > 3.0 * side, "{forward} vs {side}");
     }
 
     #[test]

@@ -134,8 +134,8 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// the ground's light from below (`ground_up / 4`), all of it at the
 /// bottom and 0.35 at the top ([`ambient_light`]), times this, which
 /// stands for that light's own multiple scattering; fitted with the
-/// octaves ([`super::lighting::sun_scattering`]).
-pub const AMBIENT_GAIN: f32 = 1.4;
+/// octaves and the diffused sunlight ([`super::lighting::sun_scattering`]).
+pub const AMBIENT_GAIN: f32 = 2.12;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4` and the
@@ -235,7 +235,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             } else {
                 (ambient_light(sky_top, ground, eta), q.octaves)
             };
-            let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, octaves) + ambient;
+            let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, octaves) + ambient;
             let s = scatter * (sigma_t * ALBEDO);
             let step_t = (-sigma_t * h).exp();
             light += integrate_step(s, sigma_t, h) * transmittance;
@@ -383,7 +383,7 @@ pub fn sea_reflection(
         let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS, &fr.fields, d);
         let tau_sun = -shadow.max(1e-30).ln();
         let eta = ((x.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, q.octaves)
+        let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves)
             + ambient_light(sky_top, ground, eta);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= (-sigma_t * h).exp();

@@ -204,7 +204,7 @@ pub fn march_volume(
             volume_optical_depth(p, sun_dir, shadow_ray_length(p, sun_dir, d), params, stack);
         let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
         let ambient = ambient_light(sky_top, ground, eta);
-        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, q.octaves) + ambient)
+        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves) + ambient)
             * (sigma_t * ALBEDO);
         let step_t = (-sigma_t * dt).exp();
         light += integrate_step(src, sigma_t, dt) * transmittance;

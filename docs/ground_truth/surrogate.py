@@ -1,0 +1,252 @@
+#!/usr/bin/env python3
+"""How the light's gains were chosen: a numpy surrogate of our cloud
+march, on the grid `cumulus export` writes, fitted to the path tracer.
+
+For each view of compare.py, every camera ray (2x2 per pixel) is marched
+through the exported grid (trilinear, 10 m steps) and each cloud sample
+keeps its weight toward the camera, its height and its optical depths
+toward the sun, away from it, up and down (20 m steps over 2 km). The
+background (the sky through the cloud) is Mitsuba's own render of the
+environment map alone. Any light model that is a sum of terms with
+gains is then a least-squares fit of those gains, one set for all three
+views, to the path tracer's cached reference, weighted as relative
+error on cloud pixels: each candidate is scored in a second.
+
+    python3 docs/ground_truth/compare.py --width 80 --height 60 --spp 2048 --cells 512 --supersample 4 --cache /tmp/gt
+    python3 docs/ground_truth/surrogate.py --cache /tmp/gt [--out docs/ground_truth]
+
+Writes surrogate.csv (mean relative error, bias and tops per view, and
+the fitted gains, per model). The surrogate lacks our detail noise below
+the grid's 20 m and our shadow ray's growing steps, so it reads a few
+points below the renderer; compare.py measures the renderer itself.
+Same setup as compare.py (Mitsuba 3.9.1, DRJIT_LIBLLVM_PATH on Debian 12).
+"""
+
+import argparse
+import csv
+import json
+import os
+import sys
+import tempfile
+
+import numpy as np
+from scipy.ndimage import map_coordinates
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import compare as C  # noqa: E402
+
+Y = np.array([0.2126, 0.7152, 0.0722])
+ALBEDO = 0.99
+
+
+def hg(c, g):
+    return (1 - g * g) / (4 * np.pi * np.maximum(1 + g * g - 2 * g * c, 1e-6) ** 1.5)
+
+
+def dual(c, e):
+    """render::cpu::lighting::phase_dual."""
+    return 0.75 * hg(c, 0.8 * e) + 0.25 * hg(c, -0.3 * e)
+
+
+def march_samples(side, vol, width, height, ss=2, dt=10.0):
+    """Cloud samples along the camera rays: pixel, weight toward the camera
+    (transmittance times the step's opacity, over ss²), extinction,
+    position; and each pixel's transmittance."""
+    lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
+    cell = (hi - lo) / np.array(side["resolution"])
+
+    def sigma(p):
+        g = (p - lo) / cell - 0.5
+        return map_coordinates(vol, [g[:, 2], g[:, 1], g[:, 0]], order=1, mode="constant", cval=0.0)
+
+    eye, dirs = C.camera_rays(side, width * ss, height * ss)
+    dirs = dirs.reshape(-1, 3)
+    rows, cols = np.meshgrid(np.arange(height * ss) // ss, np.arange(width * ss) // ss, indexing="ij")
+    pix = (rows * width + cols).reshape(-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0, t1 = (lo - eye) / dirs, (hi - eye) / dirs
+    tn = np.nanmax(np.minimum(t0, t1), axis=1).clip(0)
+    tf = np.nanmin(np.maximum(t0, t1), axis=1)
+    T = np.ones(len(dirs))
+    t = tn.copy()
+    alive = tf > tn
+    out = []
+    while alive.any():
+        idx = np.nonzero(alive)[0]
+        tm = t[idx] + 0.5 * dt
+        p = eye + dirs[idx] * tm[:, None]
+        s = sigma(p)
+        k = s > 0
+        if k.any():
+            ii = idx[k]
+            out.append((ii, p[k], s[k], T[ii] * (1 - np.exp(-s[k] * dt))))
+            T[ii] *= np.exp(-s[k] * dt)
+        t[idx] += dt
+        alive = (t < tf) & (T > 1e-3)
+    ray = np.concatenate([o[0] for o in out])
+    P = np.concatenate([o[1] for o in out])
+    smp = {"pix": pix[ray], "w": np.concatenate([o[3] for o in out]) / ss**2,
+           "sigma": np.concatenate([o[2] for o in out]), "cos": None, "y": P[:, 1],
+           "T": np.bincount(pix, T, width * height) / ss**2}
+    sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
+    smp["cos"] = dirs[ray] @ sun
+
+    def depth(d, length=2000.0, step=20.0):
+        acc = np.zeros(len(P))
+        for j in range(int(length / step)):
+            acc += sigma(P + d * (j + 0.5) * step) * step
+        return acc
+
+    for name, d in [("sun", sun), ("anti", -sun), ("up", np.array([0, 1.0, 0])),
+                    ("down", np.array([0, -1.0, 0]))]:
+        smp["tau_" + name] = depth(d)
+    return smp
+
+
+def sky_terms(side, sky_path, width, height):
+    """Mitsuba's render of the environment map alone (the background), and
+    the map's mean radiance over the upper and lower hemispheres."""
+    import mitsuba as mi
+
+    mi.set_variant("llvm_ad_rgb")
+    T = mi.ScalarTransform4f
+    scene = mi.load_dict({
+        "type": "scene", "integrator": {"type": "path"},
+        "sensor": {"type": "perspective", "fov_axis": "y", "fov": side["camera_fov_y_deg"],
+                   "to_world": T().look_at(origin=side["camera_origin_m"],
+                                           target=side["camera_target_m"], up=side["camera_up"]),
+                   "film": {"type": "hdrfilm", "width": width, "height": height,
+                            "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+                   "sampler": {"type": "independent", "sample_count": 64}},
+        "sky": {"type": "envmap", "filename": sky_path}})
+    bg = np.array(mi.render(scene))[:, ::-1, :3] @ Y
+    env = C.read_exr(sky_path) @ Y
+    h = env.shape[0]
+    w_row = np.sin((np.arange(h) + 0.5) / h * np.pi)[:, None]
+    up = (env[: h // 2] * w_row[: h // 2]).sum() / (w_row[: h // 2].sum() * env.shape[1])
+    down = (env[h // 2:] * w_row[h // 2:]).sum() / (w_row[h // 2:].sum() * env.shape[1])
+    return bg.reshape(-1), up, down
+
+
+def octaves(s, a, b, c, n=3):
+    """Wrenninge's octaves of the sun's light, without the gain; c = None:
+    isotropic (1/4π in place of the phase)."""
+    out, ai, bi, ci = 0.0, 1.0, 1.0, 1.0
+    for _ in range(n):
+        ai, bi = ai * a, bi * b
+        ci = ci * c if c is not None else 0.0
+        phase = dual(s["cos"], ci) if c is not None else 1 / (4 * np.pi)
+        out = out + ai * phase * np.exp(-bi * s["tau_sun"])
+    return s["E"] * s["mu"] ** 0.4 * out
+
+
+def sky(s):
+    """ambient_light without its gain: the upper sky's light, 0.35 of it at
+    the band's bottom, and the ground's, 0.35 of it at the top (1/4 of
+    each hemisphere's irradiance over π)."""
+    return s["up"] / 4 * (0.35 + 0.65 * s["eta"]) + s["down"] / 4 * (1 - 0.65 * s["eta"])
+
+
+def diffused(s, depth_m=100.0, e=None, profile=False):
+    """diffused_sun without its gain (e: a phase's eccentricity in place of
+    isotropy; profile: falling toward the base as the ambient's sky part)."""
+    phase = dual(s["cos"], e) if e is not None else 1 / (4 * np.pi)
+    shape = (0.35 + 0.65 * s["eta"]) if profile else 1.0
+    return s["E"] * s["mu"] * phase * shape * (1 - np.exp(-s["sigma"] * depth_m))
+
+
+def slab(s, z0=2.0):
+    """Diffusion through a slab along the sun's axis: light at a point in
+    proportion to its distance (plus z0) from the far face."""
+    return s["E"] / (4 * np.pi) * (s["tau_anti"] + z0) / (s["tau_sun"] + s["tau_anti"] + 2 * z0)
+
+
+MODELS = [
+    ("octaves (0.67, 0.32, 0.55) + sky; the fit of 2026-12-02",
+     lambda s: [octaves(s, 0.67, 0.32, 0.55), sky(s)]),
+    ("slab diffusion along the sun + sky", lambda s: [slab(s), sky(s)]),
+    ("octaves (0.67, 0.32, 0.55) + diffused (e 0.2, profile) + sky",
+     lambda s: [octaves(s, 0.67, 0.32, 0.55), diffused(s, e=0.2, profile=True), sky(s)]),
+    ("octaves (0.5, 0.5, 0.8) + diffused (e 0.2, profile) + sky",
+     lambda s: [octaves(s, 0.5, 0.5, 0.8), diffused(s, e=0.2, profile=True), sky(s)]),
+    ("octaves (0.5, 0.5, 0.8) forward + isotropic + diffused + sky; adopted",
+     lambda s: [octaves(s, 0.5, 0.5, 0.8), octaves(s, 0.5, 0.5, None), diffused(s), sky(s)]),
+]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cache", required=True, help="compare.py's --cache directory")
+    ap.add_argument("--width", type=int, default=80)
+    ap.add_argument("--height", type=int, default=60)
+    ap.add_argument("--spp", type=int, default=2048)
+    ap.add_argument("--cells", type=int, default=512)
+    ap.add_argument("--views", default=",".join(v[0] for v in C.VIEWS),
+                    help="comma-separated views; the gains are fitted to all of them")
+    ap.add_argument("--out", default=".")
+    ap.add_argument("--bin", default=os.path.join(C.ROOT, "target/release/cumulus"))
+    a = ap.parse_args()
+    data = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, base, el, az, yaw in [v for v in C.VIEWS if v[0] in a.views.split(",")]:
+            ref = os.path.join(a.cache, f"{name}_{a.width}x{a.height}_{a.spp}spp_{a.cells}cells.npy")
+            if not os.path.exists(ref):
+                sys.exit(f"{ref}: no cached reference; run compare.py with --cache {a.cache} "
+                         f"and the same --width/--height/--spp/--cells first")
+            scene = os.path.join(C.ROOT, "scenes", f".sur_{name}_{os.getpid()}.toml")
+            C.scene_variant(base, el, az, yaw, a.width, a.height, scene, C.VIEW_CAMERA.get(name, {}))
+            vol, sky_path = os.path.join(tmp, f"{name}.vol"), os.path.join(tmp, f"{name}_sky.exr")
+            try:
+                C.run([a.bin, "export", "--scene", scene, "--out", vol, "--sky", sky_path,
+                       "--cells", str(a.cells)])
+            finally:
+                os.remove(scene)
+            side = json.load(open(vol[:-4] + ".json"))
+            s = march_samples(side, C.read_vol(vol).astype(np.float32), a.width, a.height)
+            bg, up, down = sky_terms(side, sky_path, a.width, a.height)
+            lo, hi = side["box_min_m"][1], side["box_max_m"][1]
+            s.update(E=np.array(side["sun_irradiance_rgb"]) @ Y,
+                     mu=np.sin(np.radians(side["sun_elevation_deg"])), up=up, down=down,
+                     eta=np.clip((s["y"] - lo) / (hi - lo), 0, 1))
+            eye, dirs = C.camera_rays(side, a.width, a.height)
+            tau = C.optical_depth(C.read_vol(vol), side, eye, dirs)
+            sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
+            near_sun = np.degrees(np.arccos(np.clip(dirs @ sun, -1, 1))) < (
+                C.SUN_RADIUS_DEG + np.sqrt(2) * side["camera_fov_y_deg"] / a.height)
+            s["cloud"] = ((tau >= C.VIEW_TAU_MIN.get(name, 1.0)) & ~near_sun).reshape(-1)
+            s["truth"] = (np.load(ref) @ Y).reshape(-1)
+            n = a.width * a.height
+            pixsum = lambda f, s=s: np.bincount(s["pix"], s["w"] * ALBEDO * f, n)
+            s["base"] = pixsum(s["E"] * dual(s["cos"], 1.0) * np.exp(-s["tau_sun"])) + bg * s["T"]
+            s["pixsum"] = pixsum
+            data[name] = s
+            print(f"{name}: {len(s['pix'])} cloud samples", flush=True)
+    rows = []
+    for label, terms in MODELS:
+        X, yv, parts = [], [], {}
+        for name, s in data.items():
+            c, t = s["cloud"], s["truth"]
+            F = np.stack([s["pixsum"](f) for f in terms(s)], 1)
+            parts[name] = F
+            X.append(F[c] / t[c, None])
+            yv.append((t[c] - s["base"][c]) / t[c])
+        gains, *_ = np.linalg.lstsq(np.concatenate(X), np.concatenate(yv), rcond=None)
+        row = {"model": label, "gains": " ".join(f"{g:.2f}" for g in gains)}
+        for name, s in data.items():
+            c, t = s["cloud"], s["truth"]
+            img = s["base"] + parts[name] @ gains
+            rel = (img - t)[c] / t[c]
+            row[f"{name}_error"] = round(float(np.abs(rel).mean()), 4)
+            row[f"{name}_bias"] = round(float(rel.mean()), 4)
+            row[f"{name}_tops"] = round(float(np.percentile(img[c], 99) / np.percentile(t[c], 99)), 4)
+        rows.append(row)
+        print(label, row, flush=True)
+    os.makedirs(a.out, exist_ok=True)
+    with open(os.path.join(a.out, "surrogate.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
+if __name__ == "__main__":
+    main()
