@@ -352,6 +352,10 @@ def main():
                          "normalised_error_4x4": round(norm_b, 4),
                          "mean_luminance_ours": round(float(yo[cloud].mean()), 4),
                          "mean_luminance_mitsuba": round(float(ym[cloud].mean()), 4),
+                         # The colour, which the measure above leaves out:
+                         # mean red over mean blue on the cloud pixels.
+                         "red_over_blue_ours": round(float(ours[cloud][:, 0].mean() / ours[cloud][:, 2].mean()), 3) if n else float("nan"),
+                         "red_over_blue_mitsuba": round(float(truth[cloud][:, 0].mean() / truth[cloud][:, 2].mean()), 3) if n else float("nan"),
                          "spp": a.spp})
             if a.arrays:
                 for label, img in (("ours", ours), ("mitsuba", truth), ("tau", tau), ("cloud", cloud)):
