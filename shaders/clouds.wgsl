@@ -50,12 +50,12 @@ const SHADOW_RAY_M: f32 = 2000.0;
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.8;
-const MULTIPLE_GAIN: f32 = 0.77;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.47;
+const MULTIPLE_GAIN: f32 = 0.5;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.91;
 const MULTIPLE_SUN_POWER: f32 = 0.4;
-const DIFFUSE_GAIN: f32 = 1.03;
+const DIFFUSE_GAIN: f32 = 0.45;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const AMBIENT_GAIN: f32 = 2.12;
+const AMBIENT_GAIN: f32 = 4.23;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
 // Uniform steps of a ray the sea reflects, and its shadow samples.

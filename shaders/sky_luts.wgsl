@@ -443,10 +443,11 @@ fn sky_ambient_texel(sky_view: texture_2d<f32>, r: f32, p: SkyParams) -> vec3f {
         for (var j = 0u; j < SKY_AMBIENT_COLUMNS; j++) {
             let azimuth = (f32(j) + 0.5) / f32(SKY_AMBIENT_COLUMNS) * PI;
             let c = sky_view_texel_coords(mu, azimuth, r, p);
-            sum += sample_texels(sky_view, c.fx, c.fy, c.row_min, c.row_max);
+            sum += sample_texels(sky_view, c.fx, c.fy, c.row_min, c.row_max) * mu;
         }
     }
-    return sum / f32(SKY_AMBIENT_ROWS * SKY_AMBIENT_COLUMNS);
+    // Cosine-weighted (the CPU's `sky_ambient_texel`): Σ μ over the rows is ROWS / 2.
+    return sum * 2.0 / f32(SKY_AMBIENT_ROWS * SKY_AMBIENT_COLUMNS);
 }
 
 // ---- Lookups (src/render/cpu/sky_luts/lookups.rs) ----

@@ -104,8 +104,10 @@ def march_samples(side, vol, width, height, ss=2, dt=10.0):
 
 
 def sky_terms(side, sky_path, width, height):
-    """Mitsuba's render of the environment map alone (the background), and
-    the map's mean radiance over the upper and lower hemispheres."""
+    """Mitsuba's render of the environment map alone (the background), the
+    map's mean radiance over the upper hemisphere (uniform, and weighted by
+    the cosine from the zenith: the irradiance of level ground over π) and
+    over the lower one."""
     import mitsuba as mi
 
     mi.set_variant("llvm_ad_rgb")
@@ -124,8 +126,10 @@ def sky_terms(side, sky_path, width, height):
     h = env.shape[0]
     w_row = np.sin((np.arange(h) + 0.5) / h * np.pi)[:, None]
     up = (env[: h // 2] * w_row[: h // 2]).sum() / (w_row[: h // 2].sum() * env.shape[1])
+    c_row = (w_row * np.cos((np.arange(h) + 0.5) / h * np.pi)[:, None])[: h // 2]
+    up_cos = (env[: h // 2] * c_row).sum() / (c_row.sum() * env.shape[1])
     down = (env[h // 2:] * w_row[h // 2:]).sum() / (w_row[h // 2:].sum() * env.shape[1])
-    return bg.reshape(-1), up, down
+    return bg.reshape(-1), up, up_cos, down
 
 
 def octaves(s, a, b, c, n=3):
@@ -140,11 +144,13 @@ def octaves(s, a, b, c, n=3):
     return s["E"] * s["mu"] ** 0.4 * out
 
 
-def sky(s):
+def sky(s, cosine=False):
     """ambient_light without its gain: the upper sky's light, 0.35 of it at
     the band's bottom, and the ground's, 0.35 of it at the top (1/4 of
-    each hemisphere's irradiance over π)."""
-    return s["up"] / 4 * (0.35 + 0.65 * s["eta"]) + s["down"] / 4 * (1 - 0.65 * s["eta"])
+    each hemisphere's mean radiance; cosine: the upper one weighted by the
+    cosine from the zenith, as sky_ambient is since 2026-12-03)."""
+    up = s["up_cos"] if cosine else s["up"]
+    return up / 4 * (0.35 + 0.65 * s["eta"]) + s["down"] / 4 * (1 - 0.65 * s["eta"])
 
 
 def diffused(s, depth_m=100.0, e=None, profile=False):
@@ -169,8 +175,11 @@ MODELS = [
      lambda s: [octaves(s, 0.67, 0.32, 0.55), diffused(s, e=0.2, profile=True), sky(s)]),
     ("octaves (0.5, 0.5, 0.8) + diffused (e 0.2, profile) + sky",
      lambda s: [octaves(s, 0.5, 0.5, 0.8), diffused(s, e=0.2, profile=True), sky(s)]),
-    ("octaves (0.5, 0.5, 0.8) forward + isotropic + diffused + sky; adopted",
+    ("octaves (0.5, 0.5, 0.8) forward + isotropic + diffused + sky",
      lambda s: [octaves(s, 0.5, 0.5, 0.8), octaves(s, 0.5, 0.5, None), diffused(s), sky(s)]),
+    ("the same with the cosine-weighted sky; adopted",
+     lambda s: [octaves(s, 0.5, 0.5, 0.8), octaves(s, 0.5, 0.5, None), diffused(s),
+                sky(s, cosine=True)]),
 ]
 
 
@@ -203,10 +212,10 @@ def main():
                 os.remove(scene)
             side = json.load(open(vol[:-4] + ".json"))
             s = march_samples(side, C.read_vol(vol).astype(np.float32), a.width, a.height)
-            bg, up, down = sky_terms(side, sky_path, a.width, a.height)
+            bg, up, up_cos, down = sky_terms(side, sky_path, a.width, a.height)
             lo, hi = side["box_min_m"][1], side["box_max_m"][1]
             s.update(E=np.array(side["sun_irradiance_rgb"]) @ Y,
-                     mu=np.sin(np.radians(side["sun_elevation_deg"])), up=up, down=down,
+                     mu=np.sin(np.radians(side["sun_elevation_deg"])), up=up, up_cos=up_cos, down=down,
                      eta=np.clip((s["y"] - lo) / (hi - lo), 0, 1))
             eye, dirs = C.camera_rays(side, a.width, a.height)
             tau = C.optical_depth(C.read_vol(vol), side, eye, dirs)

@@ -304,12 +304,17 @@ pub const SKY_AMBIENT_SAMPLES: (u32, u32) = (16, 32);
 /// The sky-ambient table's size: one texel.
 pub const SKY_AMBIENT_SIZE: (u32, u32) = (1, 1);
 
-/// The sky-ambient texel: the sky's mean radiance over the upper
-/// hemisphere seen from radius `r`, read from the sky-view table on the
-/// [`SKY_AMBIENT_SAMPLES`] grid (cell centres). What lights a cloud or
-/// the ground from the whole sky, including the bright aureole around the
-/// sun at its true (small) solid angle, which a handful of fixed
-/// directions would over- or under-weight.
+/// The sky-ambient texel: the sky's irradiance of level ground over π
+/// (its radiance over the upper hemisphere weighted by the cosine from
+/// the zenith, `∫ L μ dω / π`) seen from radius `r`, read from the
+/// sky-view table on the [`SKY_AMBIENT_SAMPLES`] grid (cell centres).
+/// What lights the ground, and a cloud through its top, from the whole
+/// sky, including the bright aureole around the sun at its true (small)
+/// solid angle, which a handful of fixed directions would over- or
+/// under-weight. The cosine matters under a low sun: the uniform mean
+/// (used until 2026-12-03) weighted the red glow around the sun at the
+/// horizon as much as the blue zenith, and the path tracer's cloud bases
+/// are as blue as the cosine-weighted sky (docs/ground_truth).
 pub fn sky_ambient_texel(sky_view: &Lut2, r: f32, p: &SkyParams) -> Vec3 {
     let (rows, columns) = SKY_AMBIENT_SAMPLES;
     let mut sum = Vec3::ZERO;
@@ -318,10 +323,11 @@ pub fn sky_ambient_texel(sky_view: &Lut2, r: f32, p: &SkyParams) -> Vec3 {
         for j in 0..columns {
             let azimuth = (j as f32 + 0.5) / columns as f32 * PI;
             let (fx, fy, lo, hi) = sky_view_texel_coords(mu, azimuth, r, p);
-            sum += sky_view.sample_texels(fx, fy, lo, hi);
+            sum += sky_view.sample_texels(fx, fy, lo, hi) * mu;
         }
     }
-    sum / (rows * columns) as f32
+    // Σ μ over the rows' centres is rows / 2.
+    sum * 2.0 / (rows * columns) as f32
 }
 
 /// A 2D table of RGB texels, row-major, ready to upload as `Rgba32Float`
