@@ -184,6 +184,22 @@ def optical_depth(vol, side, eye, dirs, steps=400):
     return tau
 
 
+def cloud_pixels(name, vol_path, side, width, height):
+    """The measure's pixels: optical depth through the exported grid at
+    least the view's VIEW_TAU_MIN, less those near the sun. The path
+    tracer's sun is a directional light with no disk; ours draws the disk,
+    which shines through thin cloud at thousands of times the cloud's
+    luminance. Pixels that may hold any of it (within the disk's radius
+    and a pixel's diagonal of the sun) are left out. Returns (cloud, tau,
+    near_sun), each height x width."""
+    eye, dirs = camera_rays(side, width, height)
+    tau = optical_depth(read_vol(vol_path), side, eye, dirs)
+    sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
+    near_sun = np.degrees(np.arccos(np.clip(dirs @ sun, -1, 1))) < (
+        SUN_RADIUS_DEG + np.sqrt(2) * side["camera_fov_y_deg"] / height)
+    return (tau >= VIEW_TAU_MIN.get(name, 1.0)) & ~near_sun, tau, near_sun
+
+
 def read_vol(path):
     raw = open(path, "rb").read()
     assert raw[:4] == b"VOL\x03"
@@ -313,17 +329,7 @@ def main():
                 truth = mitsuba_render(vol, sky, side, a.spp, a.width, a.height, a.single_scattering)
                 if cached:
                     np.save(cached, truth)
-            eye, dirs = camera_rays(side, a.width, a.height)
-            tau = optical_depth(read_vol(vol), side, eye, dirs)
-            # The path tracer's sun is a directional light with no disk;
-            # ours draws the disk, which shines through thin cloud at
-            # thousands of times the cloud's luminance. Pixels that may
-            # hold any of it (within the disk's radius and a pixel's
-            # diagonal of the sun) are left out of the measure.
-            sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
-            near_sun = np.degrees(np.arccos(np.clip(dirs @ sun, -1, 1))) < (
-                SUN_RADIUS_DEG + np.sqrt(2) * side["camera_fov_y_deg"] / a.height)
-            cloud = (tau >= VIEW_TAU_MIN.get(name, 1.0)) & ~near_sun
+            cloud, tau, near_sun = cloud_pixels(name, vol, side, a.width, a.height)
             yo, ym = luminance(ours), luminance(truth)
             rel = (yo - ym) / np.maximum(ym, 1e-6)
             n = int(cloud.sum())

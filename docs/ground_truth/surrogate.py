@@ -217,12 +217,7 @@ def main():
             s.update(E=np.array(side["sun_irradiance_rgb"]) @ Y,
                      mu=np.sin(np.radians(side["sun_elevation_deg"])), up=up, up_cos=up_cos, down=down,
                      eta=np.clip((s["y"] - lo) / (hi - lo), 0, 1))
-            eye, dirs = C.camera_rays(side, a.width, a.height)
-            tau = C.optical_depth(C.read_vol(vol), side, eye, dirs)
-            sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
-            near_sun = np.degrees(np.arccos(np.clip(dirs @ sun, -1, 1))) < (
-                C.SUN_RADIUS_DEG + np.sqrt(2) * side["camera_fov_y_deg"] / a.height)
-            s["cloud"] = ((tau >= C.VIEW_TAU_MIN.get(name, 1.0)) & ~near_sun).reshape(-1)
+            s["cloud"] = C.cloud_pixels(name, vol, side, a.width, a.height)[0].reshape(-1)
             s["truth"] = (np.load(ref) @ Y).reshape(-1)
             n = a.width * a.height
             pixsum = lambda f, s=s: np.bincount(s["pix"], s["w"] * ALBEDO * f, n)
