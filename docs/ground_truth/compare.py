@@ -207,7 +207,11 @@ def read_vol(path):
     return np.frombuffer(raw[48:], "<f4").reshape(nz, ny, nx)
 
 
-def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False):
+def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False, sky=None):
+    """Mitsuba's render of the exported volume: all orders of scattering
+    of the sun and the sky's environment map, or (single) the sun's light
+    scattered once; sky=False: the sun's light alone, all orders (what
+    surrogate.py --decompose splits the light by). Returns height x width x 3."""
     import mitsuba as mi
 
     mi.set_variant("llvm_ad_rgb")
@@ -234,7 +238,8 @@ def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False):
                 "direction": [-x for x in side["sun_direction"]],
                 "irradiance": {"type": "rgb", "value": side["sun_irradiance_rgb"]}},
         # No sky under --single-scattering: the sun's light alone.
-        **({} if single else {"sky": {"type": "envmap", "filename": sky_path}}),
+        **({"sky": {"type": "envmap", "filename": sky_path}}
+           if (not single if sky is None else sky) else {}),
         "clouds": {
             "type": "cube",
             "to_world": T().translate(centre.tolist()).scale(half.tolist()),

@@ -13,10 +13,15 @@ views, to the path tracer's cached reference, weighted as relative
 error on cloud pixels: each candidate is scored in a second.
 
     python3 docs/ground_truth/compare.py --width 80 --height 60 --spp 2048 --cells 512 --supersample 4 --cache /tmp/gt
-    python3 docs/ground_truth/surrogate.py --cache /tmp/gt [--out docs/ground_truth]
+    python3 docs/ground_truth/surrogate.py --cache /tmp/gt [--out docs/ground_truth] [--decompose 1024]
 
 Writes surrogate.csv (mean relative error, bias and tops per view, and
-the fitted gains, per model). The surrogate lacks our detail noise below
+the fitted gains, per model). Two of the models are tests of a light
+the renderer does not have: the fluence of the sun's light diffused
+through the whole grid (diffusion_fluence), which no local term of the
+shadow ray gives. --decompose splits the shipped model's light into the
+sun's part and the sky's, each against its own reference (the path
+tracer's render of the sun alone), and writes decomposition.csv. The surrogate lacks our detail noise below
 the grid's 20 m and our shadow ray's growing steps, so it reads a few
 points below the renderer; compare.py measures the renderer itself.
 Same setup as compare.py (Mitsuba 3.9.1, DRJIT_LIBLLVM_PATH on Debian 12).
@@ -87,7 +92,7 @@ def march_samples(side, vol, width, height, ss=2, dt=10.0):
     P = np.concatenate([o[1] for o in out])
     smp = {"pix": pix[ray], "w": np.concatenate([o[3] for o in out]) / ss**2,
            "sigma": np.concatenate([o[2] for o in out]), "cos": None, "y": P[:, 1],
-           "T": np.bincount(pix, T, width * height) / ss**2}
+           "T": np.bincount(pix, T, width * height) / ss**2, "P": P}
     sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
     smp["cos"] = dirs[ray] @ sun
 
@@ -167,6 +172,79 @@ def slab(s, z0=2.0):
     return s["E"] / (4 * np.pi) * (s["tau_anti"] + z0) / (s["tau_sun"] + s["tau_anti"] + 2 * z0)
 
 
+def diffusion_fluence(vol, side, positions, down=2, air_mfp_m=200.0, cloud_sigma=0.004):
+    """A test of light that is not local: the fluence of the sun's light
+    diffused through the exported grid (per unit sun irradiance), by the
+    diffusion approximation on a grid `down` times coarser. Its source is
+    the sunlight scattered once, albedo · σ_t · e^{-τ_sun}; its diffusion
+    coefficient 1 / (3 σ_t (1 - g)), g the phase's mean cosine, at most
+    that of a transport path of `air_mfp_m`; clear air (σ_t under
+    `cloud_sigma`) absorbs within about a cell, as light that leaves a
+    cloud does not come back, and the box's faces are vacuum. Solved by
+    conjugate gradients; returns the fluence at `positions`."""
+    from scipy.sparse import coo_matrix, diags
+    from scipy.sparse.linalg import cg
+
+    g = sum(l["weight"] * l["g"] for l in side["phase"])
+    albedo = side["albedo"]
+    nz, ny, nx = (n // down for n in vol.shape)
+    v = vol[:nz * down, :ny * down, :nx * down].reshape(nz, down, ny, down, nx, down).mean(axis=(1, 3, 5))
+    lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
+    h = (hi - lo) / np.array([nx, ny, nz])
+    sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
+    zz, yy, xx = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
+    centres = np.stack([(xx + 0.5) * h[0], (yy + 0.5) * h[1], (zz + 0.5) * h[2]], -1).reshape(-1, 3)
+    tau = np.zeros(len(centres), np.float32)
+    for j in range(100):  # 20 m steps over 2 km, as march_samples' depths
+        q = centres / h + sun / h * (j + 0.5) * 20.0 - 0.5
+        tau += map_coordinates(v, [q[:, 2], q[:, 1], q[:, 0]], order=1, mode="constant", cval=0.0) * 20.0
+    sigma = v.reshape(-1).astype(np.float64)
+    source = albedo * sigma * np.exp(-tau)
+    D = (1.0 / (3.0 * np.maximum((1.0 - g) * sigma, 1.0 / air_mfp_m))).reshape(nz, ny, nx)
+    absorb = sigma * (1.0 - albedo) + (1.0 - np.clip(sigma / cloud_sigma, 0, 1)) / h.mean()
+    idx = np.arange(nz * ny * nx).reshape(nz, ny, nx)
+    diag, rows, cols, vals = absorb.copy(), [], [], []
+    for axis, step in ((2, h[0]), (1, h[1]), (0, h[2])):
+        a = [slice(None)] * 3
+        b = [slice(None)] * 3
+        a[axis], b[axis] = slice(0, -1), slice(1, None)
+        da, db = D[tuple(a)], D[tuple(b)]
+        w = (2 * da * db / (da + db) / step**2).ravel()
+        i, j = idx[tuple(a)].ravel(), idx[tuple(b)].ravel()
+        rows += [i, j]
+        cols += [j, i]
+        vals += [-w, -w]
+        np.add.at(diag, i, w)
+        np.add.at(diag, j, w)
+        for face in (0, -1):
+            c = [slice(None)] * 3
+            c[axis] = face
+            np.add.at(diag, idx[tuple(c)].ravel(), 2 * D[tuple(c)].ravel() / step**2)
+    n = len(diag)
+    A = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)).tocsr() + diags(diag)
+    phi, _ = cg(A, source, M=diags(1.0 / diag), maxiter=400, rtol=1e-6)
+    q = (positions - lo) / h - 0.5
+    return map_coordinates(phi.reshape(nz, ny, nx), [q[:, 2], q[:, 1], q[:, 0]], order=1, mode="nearest")
+
+
+def shipped_gains():
+    """The gains the renderer ships with, read from its source: the
+    octaves' forward and isotropic gains, the diffused light's and the
+    ambient's."""
+    import re
+
+    consts = {}
+    for f in ("src/render/cpu/lighting.rs", "src/render/cpu/renderer.rs"):
+        for k, val in re.findall(r"pub const (\w+): f32 = ([0-9.]+);", open(os.path.join(C.ROOT, f)).read()):
+            consts[k] = float(val)
+    return [consts[k] for k in ("MULTIPLE_GAIN", "MULTIPLE_ISOTROPIC_GAIN", "DIFFUSE_GAIN", "AMBIENT_GAIN")]
+
+
+def fluence(s):
+    """diffusion_fluence as a term: isotropic, per unit scattering."""
+    return s["E"] * s["phi"] / (4 * np.pi)
+
+
 MODELS = [
     ("octaves (0.67, 0.32, 0.55) + sky; the fit of 2026-12-02",
      lambda s: [octaves(s, 0.67, 0.32, 0.55), sky(s)]),
@@ -179,6 +257,11 @@ MODELS = [
      lambda s: [octaves(s, 0.5, 0.5, 0.8), octaves(s, 0.5, 0.5, None), diffused(s), sky(s)]),
     ("the same with the cosine-weighted sky; adopted",
      lambda s: [octaves(s, 0.5, 0.5, 0.8), octaves(s, 0.5, 0.5, None), diffused(s),
+                sky(s, cosine=True)]),
+    ("diffusion fluence + sky (a test; not in the renderer)",
+     lambda s: [fluence(s), sky(s, cosine=True)]),
+    ("adopted + diffusion fluence (a test; not in the renderer)",
+     lambda s: [octaves(s, 0.5, 0.5, 0.8), octaves(s, 0.5, 0.5, None), diffused(s), fluence(s),
                 sky(s, cosine=True)]),
 ]
 
@@ -194,6 +277,11 @@ def main():
                     help="comma-separated views; the gains are fitted to all of them")
     ap.add_argument("--out", default=".")
     ap.add_argument("--bin", default=os.path.join(C.ROOT, "target/release/cumulus"))
+    ap.add_argument("--decompose", type=int, metavar="SPP", default=0,
+                    help="also split the light into the sun's and the sky's parts against "
+                         "Mitsuba's render of the sun alone at SPP samples (rendered into "
+                         "--cache when absent, ~7 min a view at 1024 on 2 cores); writes "
+                         "decomposition.csv")
     a = ap.parse_args()
     data = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -211,7 +299,16 @@ def main():
             finally:
                 os.remove(scene)
             side = json.load(open(vol[:-4] + ".json"))
-            s = march_samples(side, C.read_vol(vol).astype(np.float32), a.width, a.height)
+            grid = C.read_vol(vol).astype(np.float32)
+            s = march_samples(side, grid, a.width, a.height)
+            s["phi"] = diffusion_fluence(grid, side, s["P"])
+            if a.decompose:
+                sun_ref = os.path.join(a.cache, f"{name}_{a.width}x{a.height}_{a.decompose}spp_"
+                                                f"{a.cells}cells_sun.npy")
+                if not os.path.exists(sun_ref):
+                    np.save(sun_ref, C.mitsuba_render(vol, sky_path, side, a.decompose,
+                                                      a.width, a.height, sky=False))
+                s["truth_sun"] = (np.load(sun_ref) @ Y).reshape(-1)
             bg, up, up_cos, down = sky_terms(side, sky_path, a.width, a.height)
             lo, hi = side["box_min_m"][1], side["box_max_m"][1]
             s.update(E=np.array(side["sun_irradiance_rgb"]) @ Y,
@@ -221,7 +318,9 @@ def main():
             s["truth"] = (np.load(ref) @ Y).reshape(-1)
             n = a.width * a.height
             pixsum = lambda f, s=s: np.bincount(s["pix"], s["w"] * ALBEDO * f, n)
-            s["base"] = pixsum(s["E"] * dual(s["cos"], 1.0) * np.exp(-s["tau_sun"])) + bg * s["T"]
+            s["single"] = pixsum(s["E"] * dual(s["cos"], 1.0) * np.exp(-s["tau_sun"]))
+            s["background"] = bg * s["T"]
+            s["base"] = s["single"] + s["background"]
             s["pixsum"] = pixsum
             data[name] = s
             print(f"{name}: {len(s['pix'])} cloud samples", flush=True)
@@ -246,10 +345,57 @@ def main():
         rows.append(row)
         print(label, row, flush=True)
     os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "surrogate.csv"), "w", newline="") as f:
+    write_csv(os.path.join(a.out, "surrogate.csv"), rows)
+    if a.decompose:
+        write_csv(os.path.join(a.out, "decomposition.csv"), decompose(data))
+
+
+def write_csv(path, rows):
+    with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+
+
+def decompose(data):
+    """The light of the shipped model split in two, each against its part
+    of the path tracer's: the sun's (single scattering, the octaves and
+    the diffused light) against the render of the sun alone, and the
+    sky's (the ambient and the background through the cloud) against the
+    full render less it. Per view: the parts' means, their mean relative
+    error and bias on the cloud pixels, the sun part's bias on each fifth
+    of the pixels ranked by the optical depth toward the sun (at the
+    pixel's samples, weighted as the camera sees them), and the ambient
+    gain that would fit the sky part alone (least squares)."""
+    mf, mi, di, am = shipped_gains()
+    rows = []
+    for name, s in data.items():
+        c = s["cloud"]
+        sun_truth, sky_truth = s["truth_sun"], s["truth"] - s["truth_sun"]
+        sun = s["single"] + s["pixsum"](mf * octaves(s, 0.5, 0.5, 0.8) + mi * octaves(s, 0.5, 0.5, None)
+                                        + di * diffused(s))
+        ambient = s["pixsum"](sky(s, cosine=True))
+        sky_ours = s["background"] + am * ambient
+        row = {"view": name, "cloud_pixels": int(c.sum())}
+        for part, ours, truth in (("sun", sun, sun_truth), ("sky", sky_ours, sky_truth)):
+            rel = (ours - truth)[c] / np.maximum(truth[c], 1e-3)
+            row[f"{part}_mitsuba"] = round(float(truth[c].mean()), 4)
+            row[f"{part}_ours"] = round(float(ours[c].mean()), 4)
+            row[f"{part}_error"] = round(float(np.abs(rel).mean()), 4)
+            row[f"{part}_bias"] = round(float(rel.mean()), 4)
+        weight = np.bincount(s["pix"], s["w"], len(c)) + 1e-12
+        depth = np.bincount(s["pix"], s["w"] * s["tau_sun"], len(c)) / weight
+        edges = np.quantile(depth[c], np.linspace(0, 1, 6))
+        rel = (sun - sun_truth) / np.maximum(sun_truth, 1e-3)
+        for k in range(5):
+            sel = c & (depth >= edges[k]) & (depth <= edges[k + 1])
+            row[f"sun_bias_fifth_{k + 1}"] = round(float(rel[sel].mean()), 4)
+            row[f"tau_sun_fifth_{k + 1}"] = f"{edges[k]:.1f}-{edges[k + 1]:.1f}"
+        x, y = ambient[c] / sky_truth[c].clip(1e-3), (sky_truth - s["background"])[c] / sky_truth[c].clip(1e-3)
+        row["sky_gain_alone"] = round(float((x * y).sum() / (x * x).sum()), 2)
+        rows.append(row)
+        print("decomposition", row, flush=True)
+    return rows
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@
 use std::path::Path;
 use std::sync::Once;
 
+use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
@@ -34,17 +35,95 @@ fn plot_error(path: &Path) -> impl Fn(&dyn std::fmt::Display) -> ReportError + '
     }
 }
 
-/// `v` with three significant digits, without float noise (an axis label).
-fn significant(v: f64) -> String {
+/// `v` as an axis label: at most three significant digits, no trailing
+/// zeros (0.5, 10, 0.001), powers of ten beyond 1e5 or below 1e-3 as
+/// `1e-4` (not `1.00e-4`).
+fn tick_label(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }
     let e = v.abs().log10().floor() as i32;
-    if !(-3..6).contains(&e) {
-        return format!("{v:.2e}");
+    let text = if (-3..6).contains(&e) {
+        let decimals = (2 - e).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.2e}")
+    };
+    let (mantissa, exponent) = match text.split_once('e') {
+        Some((m, x)) => (m.to_owned(), Some(x.to_owned())),
+        None => (text, None),
+    };
+    let mantissa = if mantissa.contains('.') {
+        mantissa
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_owned()
+    } else {
+        mantissa
+    };
+    match exponent {
+        Some(x) => format!("{mantissa}e{x}"),
+        None => mantissa,
     }
-    let decimals = (2 - e).max(0) as usize;
-    format!("{v:.decimals$}")
+}
+
+/// The ticks of a log axis over `[lo, hi]`: labelled ones (every decade;
+/// also 2 and 5 times it when the axis spans under three decades, so
+/// that a short axis has labels everywhere, not only above its first
+/// power of ten) and unlabelled grid lines (1..9 times each decade).
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let (lo, hi) = (lo.min(hi), lo.max(hi));
+    if !(lo > 0.0 && hi.is_finite()) {
+        return (Vec::new(), Vec::new());
+    }
+    let steps: &[f64] = if hi / lo < 1000.0 {
+        &[1.0, 2.0, 5.0]
+    } else {
+        &[1.0]
+    };
+    let (mut bold, mut light) = (Vec::new(), Vec::new());
+    for k in lo.log10().floor() as i32..=hi.log10().ceil() as i32 {
+        for m in 1..10 {
+            // Divided below 1, so that 3 tenths is the literal 0.3.
+            let v = if k >= 0 {
+                m as f64 * 10f64.powi(k)
+            } else {
+                m as f64 / 10f64.powi(-k)
+            };
+            if v < lo || v > hi {
+                continue;
+            }
+            if steps.contains(&(m as f64)) {
+                bold.push(v);
+            } else {
+                light.push(v);
+            }
+        }
+    }
+    (bold, light)
+}
+
+/// Where the legend goes: the corner of the plot (as fractions of its
+/// width and height, y up) whose legend-sized box holds the fewest of
+/// `points` and of their segments' midpoints (`points` already mapped to
+/// `[0, 1]²`); upper right on a tie.
+fn legend_corner(points: &[(f64, f64)], box_w: f64, box_h: f64) -> SeriesLabelPosition {
+    let corners = [
+        (SeriesLabelPosition::UpperRight, 1.0 - box_w, 1.0 - box_h),
+        (SeriesLabelPosition::UpperLeft, 0.0, 1.0 - box_h),
+        (SeriesLabelPosition::LowerRight, 1.0 - box_w, 0.0),
+        (SeriesLabelPosition::LowerLeft, 0.0, 0.0),
+    ];
+    let inside = |x0: f64, y0: f64| {
+        points
+            .iter()
+            .filter(|p| p.0 >= x0 && p.0 <= x0 + box_w && p.1 >= y0 && p.1 <= y0 + box_h)
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|&(_, x0, y0)| inside(x0, y0))
+        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 /// Draws the series on log-log axes; `marked` points get a black ring and
@@ -74,6 +153,42 @@ pub fn loglog_png(
     if x0 > x1 {
         (x0, x1, y0, y1) = (1.0, 10.0, 1.0, 10.0);
     }
+    let (xr, yr) = ((x0 / 1.5, x1 * 1.5), (y0 / 2.0, y1 * 2.0));
+    let (x_bold, x_light) = log_ticks(xr.0, xr.1);
+    let (y_bold, y_light) = log_ticks(yr.0, yr.1);
+    // Where each point and segment midpoint lies in the plot, as fractions.
+    let unit = |p: (f64, f64)| {
+        let f = |v: f64, r: (f64, f64)| (v / r.0).ln() / (r.1 / r.0).ln();
+        (f(p.0, xr), f(p.1, yr))
+    };
+    let mut placed = Vec::new();
+    for s in series {
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+            .map(unit)
+            .collect();
+        placed.extend(pts.iter().copied());
+        if s.joined {
+            placed.extend(
+                pts.windows(2)
+                    .map(|w| (0.5 * (w[0].0 + w[1].0), 0.5 * (w[0].1 + w[1].1))),
+            );
+        }
+    }
+    // The legend's box: about 40 px per series high, the longest name
+    // at about 8 px a character plus the swatch wide, over a plot area
+    // of about 800 x 500 px.
+    let longest = series
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0);
+    let legend_w = ((longest as f64 * 8.0 + 60.0) / 800.0).min(0.5);
+    let legend_h = ((series.len() as f64 * 22.0 + 20.0) / 500.0).min(0.5);
+    let corner = legend_corner(&placed, legend_w, legend_h);
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
@@ -83,16 +198,22 @@ pub fn loglog_png(
             .x_label_area_size(45)
             .y_label_area_size(70)
             .build_cartesian_2d(
-                (x0 / 1.5..x1 * 1.5).log_scale(),
-                (y0 / 2.0..y1 * 2.0).log_scale(),
+                (xr.0..xr.1)
+                    .log_scale()
+                    .with_key_points(x_bold)
+                    .with_light_points(x_light),
+                (yr.0..yr.1)
+                    .log_scale()
+                    .with_key_points(y_bold)
+                    .with_light_points(y_light),
             )
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
-            .x_label_formatter(&|v| significant(*v))
-            .y_label_formatter(&|v| significant(*v))
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| err(&e))?;
@@ -118,17 +239,27 @@ pub fn loglog_png(
         }
         for (x, y, label) in marked {
             // The label starts beside the ring (a pixel offset, so it never
-            // runs under the ring whatever the axes' scale).
+            // runs under the ring whatever the axes' scale), on the ring's
+            // left when it would run past the plot's right edge (about
+            // 7 px a character over a plot about 800 px wide).
+            let width = label.chars().count() as i32 * 7;
+            let room = (1.0 - unit((*x, *y)).0) * 800.0;
+            let dx = if f64::from(width + 14) > room {
+                -14 - width
+            } else {
+                14
+            };
             chart
                 .draw_series(std::iter::once(
                     EmptyElement::at((*x, *y))
                         + Circle::new((0, 0), 9, BLACK.stroke_width(2))
-                        + Text::new(label.clone(), (14, -8), ("sans-serif", 15)),
+                        + Text::new(label.clone(), (dx, -8), ("sans-serif", 15)),
                 ))
                 .map_err(|e| err(&e))?;
         }
         chart
             .configure_series_labels()
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 14))
@@ -207,4 +338,59 @@ pub fn bars_png(
         path: path.to_owned(),
         source,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(100.0), "100");
+        assert_eq!(tick_label(10.0), "10");
+        assert_eq!(tick_label(0.5), "0.5");
+        assert_eq!(tick_label(0.001), "0.001");
+        assert_eq!(tick_label(2.5), "2.5");
+        assert_eq!(tick_label(1e-4), "1e-4");
+        assert_eq!(tick_label(2e6), "2e6");
+    }
+
+    #[test]
+    fn a_short_log_axis_is_labelled_below_its_first_decade() {
+        // The render-quality plot's time axis, 0.17 to 4.7 s: it had
+        // labels at 1, 2, 3 and 4 only.
+        let (bold, light) = log_ticks(0.17, 4.7);
+        assert_eq!(bold, vec![0.2, 0.5, 1.0, 2.0]);
+        assert!(light.contains(&0.3) && light.contains(&4.0) && !light.contains(&0.1));
+        // Many decades: only the powers of ten are labelled.
+        let (bold, _) = log_ticks(1e-4, 300.0);
+        assert_eq!(bold.len(), 7);
+        assert!(log_ticks(0.0, 1.0).0.is_empty());
+    }
+
+    #[test]
+    fn the_legend_avoids_the_curves() {
+        // A curve falling from the upper left to the lower right (the
+        // convergence plot's): the legend goes to an empty corner.
+        let falling: Vec<(f64, f64)> = (0..=20)
+            .map(|i| (i as f64 / 20.0, 1.0 - i as f64 / 20.0))
+            .collect();
+        let c = legend_corner(&falling, 0.2, 0.2);
+        assert!(matches!(
+            c,
+            SeriesLabelPosition::UpperRight | SeriesLabelPosition::LowerLeft
+        ));
+        let rising: Vec<(f64, f64)> = falling.iter().map(|p| (p.0, 1.0 - p.1)).collect();
+        let c = legend_corner(&rising, 0.2, 0.2);
+        assert!(matches!(
+            c,
+            SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
+        ));
+        // Points in every corner but the lower left.
+        let pts = [(0.9, 0.9), (0.1, 0.9), (0.9, 0.1)];
+        assert!(matches!(
+            legend_corner(&pts, 0.2, 0.2),
+            SeriesLabelPosition::LowerLeft
+        ));
+    }
 }
