@@ -53,6 +53,24 @@ def dual(c, e):
     return 0.75 * hg(c, 0.8 * e) + 0.25 * hg(c, -0.3 * e)
 
 
+def grid_sampler(vol, lo, cell):
+    """σ_t at world points, trilinear in the grid `vol` (z, y, x) whose
+    box starts at `lo` with cells of `cell` m; 0 outside it."""
+    def sigma(p):
+        g = (p - lo) / cell - 0.5
+        return map_coordinates(vol, [g[:, 2], g[:, 1], g[:, 0]], order=1, mode="constant", cval=0.0)
+    return sigma
+
+
+def optical_depth(sigma, points, direction, length=2000.0, step=20.0):
+    """The optical depth from each of `points` along `direction`, in
+    `step` m steps over `length` m."""
+    acc = np.zeros(len(points))
+    for j in range(int(length / step)):
+        acc += sigma(points + direction * (j + 0.5) * step) * step
+    return acc
+
+
 def march_samples(side, vol, width, height, ss=2, dt=10.0):
     """Cloud samples along the camera rays: pixel, weight toward the camera
     (transmittance times the step's opacity, over ss²), extinction,
@@ -60,10 +78,7 @@ def march_samples(side, vol, width, height, ss=2, dt=10.0):
     lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
     cell = (hi - lo) / np.array(side["resolution"])
 
-    def sigma(p):
-        g = (p - lo) / cell - 0.5
-        return map_coordinates(vol, [g[:, 2], g[:, 1], g[:, 0]], order=1, mode="constant", cval=0.0)
-
+    sigma = grid_sampler(vol, lo, cell)
     eye, dirs = C.camera_rays(side, width * ss, height * ss)
     dirs = dirs.reshape(-1, 3)
     rows, cols = np.meshgrid(np.arange(height * ss) // ss, np.arange(width * ss) // ss, indexing="ij")
@@ -96,15 +111,9 @@ def march_samples(side, vol, width, height, ss=2, dt=10.0):
     sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
     smp["cos"] = dirs[ray] @ sun
 
-    def depth(d, length=2000.0, step=20.0):
-        acc = np.zeros(len(P))
-        for j in range(int(length / step)):
-            acc += sigma(P + d * (j + 0.5) * step) * step
-        return acc
-
     for name, d in [("sun", sun), ("anti", -sun), ("up", np.array([0, 1.0, 0])),
                     ("down", np.array([0, -1.0, 0]))]:
-        smp["tau_" + name] = depth(d)
+        smp["tau_" + name] = optical_depth(sigma, P, d)
     return smp
 
 
@@ -194,10 +203,7 @@ def diffusion_fluence(vol, side, positions, down=2, air_mfp_m=200.0, cloud_sigma
     sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
     zz, yy, xx = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
     centres = np.stack([(xx + 0.5) * h[0], (yy + 0.5) * h[1], (zz + 0.5) * h[2]], -1).reshape(-1, 3)
-    tau = np.zeros(len(centres), np.float32)
-    for j in range(100):  # 20 m steps over 2 km, as march_samples' depths
-        q = centres / h + sun / h * (j + 0.5) * 20.0 - 0.5
-        tau += map_coordinates(v, [q[:, 2], q[:, 1], q[:, 0]], order=1, mode="constant", cval=0.0) * 20.0
+    tau = optical_depth(grid_sampler(v, lo, h), lo + centres, sun)
     sigma = v.reshape(-1).astype(np.float64)
     source = albedo * sigma * np.exp(-tau)
     D = (1.0 / (3.0 * np.maximum((1.0 - g) * sigma, 1.0 / air_mfp_m))).reshape(nz, ny, nx)
