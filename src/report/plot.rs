@@ -126,6 +126,13 @@ fn legend_corner(points: &[(f64, f64)], box_w: f64, box_h: f64) -> SeriesLabelPo
         .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
+/// About how wide a character of the plots' labels is, px.
+const CHAR_PX: f64 = 7.0;
+/// About the size of a log-log plot's area inside its 900 x 600 px
+/// image, px: less the margins (15 each side), the y labels (70) and
+/// the x labels and caption (45 and about 30).
+const PLOT_PX: (f64, f64) = (900.0 - 30.0 - 70.0, 600.0 - 30.0 - 45.0 - 30.0);
+
 /// Draws the series on log-log axes; `marked` points get a black ring and
 /// a label.
 pub fn loglog_png(
@@ -139,12 +146,19 @@ pub fn loglog_png(
     let err = plot_error(path);
     let (w, h) = (900u32, 600u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
-    let pts = series
+    // Each series' points a log axis can show.
+    let kept: Vec<Vec<(f64, f64)>> = series
         .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
+        .map(|s| {
+            s.points
+                .iter()
+                .copied()
+                .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+                .collect()
+        })
+        .collect();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in pts {
+    for &(x, y) in kept.iter().flatten() {
         x0 = x0.min(x);
         x1 = x1.max(x);
         y0 = y0.min(y);
@@ -162,14 +176,8 @@ pub fn loglog_png(
         (f(p.0, xr), f(p.1, yr))
     };
     let mut placed = Vec::new();
-    for s in series {
-        let pts: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .copied()
-            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-            .map(unit)
-            .collect();
+    for (s, points) in series.iter().zip(&kept) {
+        let pts: Vec<(f64, f64)> = points.iter().copied().map(unit).collect();
         placed.extend(pts.iter().copied());
         if s.joined {
             placed.extend(
@@ -178,16 +186,15 @@ pub fn loglog_png(
             );
         }
     }
-    // The legend's box: about 40 px per series high, the longest name
-    // at about 8 px a character plus the swatch wide, over a plot area
-    // of about 800 x 500 px.
+    // The legend's box: about 22 px per series high, the longest name
+    // plus the swatch wide, over the plot area.
     let longest = series
         .iter()
         .map(|s| s.name.chars().count())
         .max()
         .unwrap_or(0);
-    let legend_w = ((longest as f64 * 8.0 + 60.0) / 800.0).min(0.5);
-    let legend_h = ((series.len() as f64 * 22.0 + 20.0) / 500.0).min(0.5);
+    let legend_w = ((longest as f64 * CHAR_PX + 60.0) / PLOT_PX.0).min(0.5);
+    let legend_h = ((series.len() as f64 * 22.0 + 20.0) / PLOT_PX.1).min(0.5);
     let corner = legend_corner(&placed, legend_w, legend_h);
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -217,14 +224,8 @@ pub fn loglog_png(
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| err(&e))?;
-        for (k, s) in series.iter().enumerate() {
+        for (k, (s, points)) in series.iter().zip(&kept).enumerate() {
             let color = Palette99::pick(k).to_rgba();
-            let points: Vec<(f64, f64)> = s
-                .points
-                .iter()
-                .copied()
-                .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-                .collect();
             let line = if s.joined { points.clone() } else { Vec::new() };
             chart
                 .draw_series(LineSeries::new(line, color.stroke_width(2)))
@@ -240,10 +241,9 @@ pub fn loglog_png(
         for (x, y, label) in marked {
             // The label starts beside the ring (a pixel offset, so it never
             // runs under the ring whatever the axes' scale), on the ring's
-            // left when it would run past the plot's right edge (about
-            // 7 px a character over a plot about 800 px wide).
-            let width = label.chars().count() as i32 * 7;
-            let room = (1.0 - unit((*x, *y)).0) * 800.0;
+            // left when it would run past the plot's right edge.
+            let width = (label.chars().count() as f64 * CHAR_PX) as i32;
+            let room = (1.0 - unit((*x, *y)).0) * PLOT_PX.0;
             let dx = if f64::from(width + 14) > room {
                 -14 - width
             } else {
