@@ -45,7 +45,9 @@ const MIN_TRANSMITTANCE: f32 = 0.01;
 const SUN_DISK_COS: f32 = 0.999989;
 const WATER_F0: f32 = 0.0204;
 // The longest shadow ray toward the sun, m.
-const SHADOW_RAY_M: f32 = 2000.0;
+const SHADOW_RAY_M: f32 = 12000.0;
+const SHADOW_STEP_SPAN_M: f32 = 2000.0;
+const SHADOW_STEP_FACTOR_MAX: f32 = 3.0;
 // Multiple scattering and sky light (the CPU's lighting.rs, renderer.rs).
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
@@ -346,7 +348,7 @@ fn shadow_parts(steps: u32) -> f32 {
 
 // The length of the shadow ray from p toward the sun: to the band's top,
 // at most SHADOW_RAY_M (the CPU's `shadow_ray_length`). The march takes
-// its SHADOW_STEPS steps of growing length (√1, √2, √3, ... parts of
+// its shadow_step_count steps of growing length (√1, √2, √3, ... parts of
 // shadow_parts) itself, as the CPU's `sun_optical_depth` does.
 fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
     var to_top = SHADOW_RAY_M;
@@ -354,6 +356,14 @@ fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
         to_top = max(frame.band.y - p.y, 0.0) / sun_dir.y;
     }
     return min(to_top, SHADOW_RAY_M);
+}
+
+// The steps of a shadow ray of `length` m: `steps` over SHADOW_STEP_SPAN_M
+// or less, in proportion beyond, at most SHADOW_STEP_FACTOR_MAX times
+// (the CPU's `shadow_step_count`).
+fn shadow_step_count(steps: u32, length: f32) -> u32 {
+    let factor = clamp(length / SHADOW_STEP_SPAN_M, 1.0, SHADOW_STEP_FACTOR_MAX);
+    return u32(ceil(f32(steps) * factor));
 }
 
 // The sunlight diffused through the cloud layer, per unit scattering
@@ -648,7 +658,6 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let sky_top = sky_ambient(sun_dir) * 0.25;
     let ground = ground_up(sun_dir, SEA) * 0.25;
     let cos_theta = dot(dir, sun_dir);
-    let parts = shadow_parts(SHADOW_STEPS);
     var transmittance = 1.0;
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
@@ -665,15 +674,17 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     var ta = t0;
     var tb = t0;
     // The lit sub-sample whose light is still to be added, and its shadow
-    // ray: steps taken (SHADOW_STEPS: done), length, distance, optical
-    // depth so far (the whole ray's once it is done, when the light is
-    // added).
+    // ray: steps taken and to take (equal: done), the steps' weights'
+    // sum, length, distance, optical depth so far (the whole ray's once
+    // it is done, when the light is added).
     var lit = false;
     var lit_t = 0.0;
     var lit_p = vec3f(0.0);
     var lit_footprint = 0.0;
     var lit_sigma = 0.0;
-    var k = SHADOW_STEPS;
+    var k = 0u;
+    var shadow_count = 0u;
+    var parts = 0.0;
     var shadow_length = 0.0;
     var shadow_t = 0.0;
     var tau = 0.0;
@@ -685,11 +696,11 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
         var dt = 0.0;
         var kind = 0u; // 0: interval end, 1: sub-sample, 2: shadow step
         var t = 0.0;
-        if k < SHADOW_STEPS {
+        if k < shadow_count {
             dt = shadow_length * sqrt(f32(k + 1u)) / parts;
             q = lit_p + sun_dir * (shadow_t + 0.5 * dt);
             if height_fraction(q.y) > 1.0 {
-                k = SHADOW_STEPS;
+                k = shadow_count;
             } else {
                 kind = 2u;
                 q_footprint = lit_footprint;
@@ -754,6 +765,8 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 tau = 0.0;
                 shadow_t = 0.0;
                 shadow_length = shadow_ray_length(q, sun_dir);
+                shadow_count = shadow_step_count(SHADOW_STEPS, shadow_length);
+                parts = shadow_parts(shadow_count);
                 k = 0u;
             }
         }

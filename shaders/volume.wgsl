@@ -19,6 +19,8 @@ struct VolumeParams {
 
 // Samples of a lit sample's shadow march towards the sun.
 const VOLUME_SHADOW_STEPS: u32 = 6u;
+// The longest of those marches, m (the CPU's `VOLUME_SHADOW_RAY_M`).
+const VOLUME_SHADOW_RAY_M: f32 = 2000.0;
 
 fn volume_texel(x: i32, y: i32, z: i32) -> f32 {
     return textureLoad(volumes, vec3i(x, y, z), 0).r;
@@ -106,7 +108,8 @@ fn march_volume(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
         if sigma_t <= 0.0 {
             continue;
         }
-        let tau_sun = volume_optical_depth(p, sun_dir, shadow_ray_length(p, sun_dir));
+        let length = min(shadow_ray_length(p, sun_dir), VOLUME_SHADOW_RAY_M);
+        let tau_sun = volume_optical_depth(p, sun_dir, length);
         let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
         let ambient = ambient_light(sky_top, ground, eta);
         let src = (sun * sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + ambient) * (sigma_t * ALBEDO);

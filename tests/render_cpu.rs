@@ -5,7 +5,9 @@ use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::density::{
     BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
 };
-use cumulus::render::cpu::lighting::{phase_dual, sun_transmittance};
+use cumulus::render::cpu::lighting::{
+    SHADOW_STEP_SPAN_M, phase_dual, shadow_ray_length, sun_optical_depth, sun_transmittance,
+};
 use cumulus::render::cpu::renderer::{
     ALBEDO, Frame, Quality, flat_ground_shadow, march_ray, render_linear, sea_reflection, to_srgb8,
 };
@@ -166,6 +168,61 @@ fn transmittance_is_in_unit_range_and_monotone_along_a_ray() {
             assert!(t >= prev - 1e-6, "step {k}: {t} < {prev}");
         }
         prev = t;
+    }
+}
+
+#[test]
+fn a_low_suns_shadow_ray_crosses_the_whole_band() {
+    // From the band's bottom toward a sun 8° up, the light crosses 7.2 km
+    // of a 1 km band. The shadow ray's optical depth must be that whole
+    // path's, as a 100,000-point quadrature of the same density along it
+    // finds it: capped at 2 km (before 2026-12-03) it saw under a third.
+    // A wide footprint keeps the detail noise smooth, so the 60 steps'
+    // estimate is a quadrature too (tolerance 5 %).
+    let cm = cloud_map();
+    let p = ProjectedField::uniform(16, 16, [1.0, 1.0, 1.0]);
+    let f = Fields {
+        p: &p,
+        cloud_map: &cm,
+    };
+    let d = DensityParams {
+        extinction_per_m: 0.001,
+        detail_strength: 1.0,
+        ..D
+    };
+    let el = 8f32.to_radians();
+    let sun = Vec3::new(el.cos() * 0.6, el.sin(), el.cos() * 0.8);
+    let footprint = 400.0;
+    for start in [
+        Vec3::new(1234.0, 600.0, 777.0),
+        Vec3::new(8000.0, 900.0, 3000.0),
+    ] {
+        let length = shadow_ray_length(start, sun, &d);
+        let through = (d.band_top_m - start.y) / sun.y;
+        assert!(
+            (length - through).abs() < 1.0 && length > 2.0 * SHADOW_STEP_SPAN_M,
+            "{length} m"
+        );
+        let n = 100_000;
+        let dt = length / n as f32;
+        let exact: f64 = (0..n)
+            .map(|i| {
+                density_at(
+                    start + sun * ((i as f32 + 0.5) * dt),
+                    &f,
+                    &d,
+                    true,
+                    footprint,
+                ) as f64
+                    * dt as f64
+            })
+            .sum();
+        let tau = sun_optical_depth(start, sun, 20, footprint, &f, &d) as f64;
+        assert!(exact > 1.0, "a real shadow: τ = {exact}");
+        assert!(
+            (tau / exact - 1.0).abs() < 0.05,
+            "from {start}: {tau} vs {exact}"
+        );
     }
 }
 

@@ -50,6 +50,10 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             "VOLUME_SHADOW_STEPS",
             cumulus::render::cpu::volume::VOLUME_SHADOW_STEPS as f64,
         ),
+        (
+            "VOLUME_SHADOW_RAY_M",
+            cumulus::render::cpu::volume::VOLUME_SHADOW_RAY_M as f64,
+        ),
         ("BASE_RAMP", density::BASE_RAMP as f64),
         ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
@@ -72,6 +76,11 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("SUN_DISK_COS", sky::SUN_DISK_COS as f64),
         ("WATER_F0", sky::WATER_F0 as f64),
         ("SHADOW_RAY_M", lighting::SHADOW_RAY_M as f64),
+        ("SHADOW_STEP_SPAN_M", lighting::SHADOW_STEP_SPAN_M as f64),
+        (
+            "SHADOW_STEP_FACTOR_MAX",
+            lighting::SHADOW_STEP_FACTOR_MAX as f64,
+        ),
         ("OCTAVE_SCATTERING", lighting::OCTAVE_SCATTERING as f64),
         ("OCTAVE_EXTINCTION", lighting::OCTAVE_EXTINCTION as f64),
         ("OCTAVE_ECCENTRICITY", lighting::OCTAVE_ECCENTRICITY as f64),

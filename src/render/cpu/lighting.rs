@@ -21,8 +21,21 @@ pub fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
     0.75 * phase_hg(cos_theta, 0.8 * eccentricity) + 0.25 * phase_hg(cos_theta, -0.3 * eccentricity)
 }
 
-/// The longest shadow ray toward the sun, m (`SHADOW_RAY_M` in WGSL).
-pub const SHADOW_RAY_M: f32 = 2000.0;
+/// The longest shadow ray toward the sun, m (`SHADOW_RAY_M` in WGSL): a
+/// sun 8° up crosses a 1.5 km band in 11 km, and the clouds that far
+/// toward it shade a low sun's light (docs/ground_truth: capped at 2 km,
+/// the low sun's single scattering was 3 times the path tracer's).
+pub const SHADOW_RAY_M: f32 = 12_000.0;
+
+/// The shadow ray's length over which it takes `render.shadow_steps`
+/// steps (`SHADOW_STEP_SPAN_M` in WGSL); a longer one, toward a lower sun,
+/// takes proportionally more ([`shadow_step_count`]).
+pub const SHADOW_STEP_SPAN_M: f32 = 2_000.0;
+
+/// The most steps a long shadow ray takes, as a multiple of
+/// `render.shadow_steps` (`SHADOW_STEP_FACTOR_MAX` in WGSL): the cost of
+/// a sun below about 20° is at most this many times a high sun's.
+pub const SHADOW_STEP_FACTOR_MAX: f32 = 3.0;
 
 /// The length of the shadow ray from `p` toward the sun: to the band's
 /// top, at most [`SHADOW_RAY_M`] (along a sun at or below the horizon,
@@ -37,6 +50,18 @@ pub fn shadow_ray_length(p: Vec3, sun_dir: Vec3, d: &DensityParams) -> f32 {
     to_top.min(SHADOW_RAY_M)
 }
 
+/// The number of steps of a shadow ray of `length` m: `steps` over
+/// [`SHADOW_STEP_SPAN_M`] or less, in proportion beyond it, at most
+/// [`SHADOW_STEP_FACTOR_MAX`] times `steps` (rounded up). A fixed count
+/// over a long ray takes long far steps, which step over the clouds
+/// between a low sun and the sample: 20 steps over the low sun's 11 km
+/// leaked nearly as much as the 2 km cap.
+#[inline]
+pub fn shadow_step_count(steps: u32, length: f32) -> u32 {
+    let factor = (length / SHADOW_STEP_SPAN_M).clamp(1.0, SHADOW_STEP_FACTOR_MAX);
+    (steps as f32 * factor).ceil() as u32
+}
+
 /// The sum of the shadow ray's step weights, `Σ_{k=1..steps} √k`: step
 /// `i` (from 0) is `√(i + 1) / shadow_parts(steps)` of the ray.
 #[inline]
@@ -49,12 +74,14 @@ pub fn shadow_parts(steps: u32) -> f32 {
 }
 
 /// Optical depth (dimensionless) from `p` toward the sun through the band,
-/// by `steps` samples whose lengths grow as `√1, √2, √3, ...` parts
-/// ([`shadow_parts`]) over at most [`SHADOW_RAY_M`]: fine near `p`, where
-/// a cloud's own edge decides its light, without the long far steps of a
-/// linear growth, which step over small wisps. Reading the density as the primary march
-/// does (the detail noise included, at the level of detail of
-/// `footprint_m`, the primary sample's). The path tracer measured what
+/// by [`shadow_step_count`] samples (`steps` over a ray of up to
+/// [`SHADOW_STEP_SPAN_M`]) whose lengths grow as `√1, √2, √3, ...` parts
+/// ([`shadow_parts`]) over the ray to the band's top, at most
+/// [`SHADOW_RAY_M`] ([`shadow_ray_length`]): fine near `p`, where a
+/// cloud's own edge decides its light, without the long far steps of a
+/// linear growth, which step over small wisps. Reading the density as the
+/// primary march does (the detail noise included, at the level of detail
+/// of `footprint_m`, the primary sample's). The path tracer measured what
 /// leaving the detail out costs (docs/ground_truth): its mean stands in
 /// for the noise, small eroded wisps vanish from the shadow, and backlit
 /// clouds glowed 7 times too bright. Few long steps leak the same way
@@ -72,10 +99,11 @@ pub fn sun_optical_depth(
         return 0.0;
     }
     let length = shadow_ray_length(p, sun_dir, d);
-    let parts = shadow_parts(steps);
+    let count = shadow_step_count(steps, length);
+    let parts = shadow_parts(count);
     let mut t = 0.0;
     let mut tau = 0.0;
-    for i in 0..steps {
+    for i in 0..count {
         let dt = length * ((i + 1) as f32).sqrt() / parts;
         let q = p + sun_dir * (t + 0.5 * dt);
         if height_fraction(q.y, d) > 1.0 {

@@ -24,6 +24,11 @@ use super::standalone::{analytic, hazed_clouds, render_standalone};
 /// Samples of a lit sample's shadow march towards the sun.
 pub const VOLUME_SHADOW_STEPS: u32 = 6;
 
+/// The longest of those marches, m: six even steps over the cloud
+/// march's longer ray toward a low sun (`SHADOW_RAY_M`) would each be
+/// nearly 2 km, longer than the clouds they should find.
+pub const VOLUME_SHADOW_RAY_M: f32 = 2_000.0;
+
 // Keep in sync with shaders/volume.wgsl: VolumeParams.
 /// Where the volumes lie and which two a frame blends.
 #[repr(C)]
@@ -148,7 +153,7 @@ pub fn volume_density(p: Vec3, params: &VolumeParams, stack: &VolumeStack) -> f3
 }
 
 /// The sun's optical depth from `p`: [`VOLUME_SHADOW_STEPS`] even steps
-/// along the shadow ray (to the band's top, at most `SHADOW_RAY_M`).
+/// along the shadow ray (to the band's top, at most [`VOLUME_SHADOW_RAY_M`]).
 #[inline]
 pub fn volume_optical_depth(
     p: Vec3,
@@ -200,8 +205,8 @@ pub fn march_volume(
         if sigma_t <= 0.0 {
             continue;
         }
-        let tau_sun =
-            volume_optical_depth(p, sun_dir, shadow_ray_length(p, sun_dir, d), params, stack);
+        let length = shadow_ray_length(p, sun_dir, d).min(VOLUME_SHADOW_RAY_M);
+        let tau_sun = volume_optical_depth(p, sun_dir, length, params, stack);
         let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
         let ambient = ambient_light(sky_top, ground, eta);
         let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves) + ambient)
