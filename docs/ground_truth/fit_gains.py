@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""Fits the light's four gains (the octaves' forward and isotropic
+parts, the diffused sunlight's, the ambient's) on the renderer's own
+images, against the path tracer's references.
+
+    python3 docs/ground_truth/compare.py --width 80 --height 60 --spp 1024 --cells 1024 \\
+        --supersample 4 --cache /tmp/gt --arrays --out /tmp/gt/arrays
+    docs/ground_truth/gain_parts.sh /tmp/parts
+    python3 docs/ground_truth/fit_gains.py --bins /tmp/parts --arrays /tmp/gt/arrays
+
+Each view is rendered by each of gain_parts.sh's builds (CPU, 4x
+supersampled as compare.py does); the image is linear in the gains, so
+a set of gains is the zero build's image plus the parts', and every
+candidate is scored in milliseconds. Prints, per fit, the gains and each
+view's mean relative luminance error, bias, tops ratio and red over
+blue (ours over Mitsuba's) on compare.py's cloud pixels. Fits: least
+squares on the relative error; Nelder-Mead on the summed per-pixel
+errors; the same plus |log| of the red-over-blue ratios.
+"""
+
+import argparse
+import os
+import sys
+import tempfile
+
+import numpy as np
+from scipy.optimize import minimize
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import compare as C  # noqa: E402
+
+Y = np.array([0.2126, 0.7152, 0.0722])
+PARTS = ["mf", "mi", "di", "am"]
+
+
+def render(binary, name, width, height, ss, extra, tmp):
+    """Our linear image of view `name` by `binary`, averaged per pixel."""
+    _, base, el, az, yaw = next(v for v in C.VIEWS if v[0] == name)
+    scene = os.path.join(C.ROOT, "scenes", f".fit_{name}_{os.getpid()}.toml")
+    C.scene_variant(base, el, az, yaw, width * ss, height * ss, scene,
+                    {**C.VIEW_CAMERA.get(name, {}), **extra})
+    exr = os.path.join(tmp, f"{name}.exr")
+    try:
+        C.run([binary, "render", "--scene", scene, "--backend", "cpu", "--out", exr])
+    finally:
+        os.remove(scene)
+    return C.read_exr(exr).reshape(height, ss, width, ss, 3).mean(axis=(1, 3))
+
+
+def scores(data, g):
+    out = []
+    for truth, zero, parts in data.values():
+        img = zero + parts @ g
+        yo, ym = img @ Y, truth @ Y
+        rel = (yo - ym) / ym
+        rb = (img[:, 0].mean() / img[:, 2].mean()) / (truth[:, 0].mean() / truth[:, 2].mean())
+        out.append((np.abs(rel).mean(), rel.mean(), np.percentile(yo, 99) / np.percentile(ym, 99), rb))
+    return out
+
+
+def show(label, data, g):
+    print(f"{label}: gains " + " ".join(f"{x:.3f}" for x in g))
+    for name, (e, b, t, rb) in zip(data, scores(data, g)):
+        print(f"  {name:9s} error {e:.4f}  bias {b:+.4f}  tops {t:.3f}  red/blue {rb:.3f}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--bins", required=True, help="gain_parts.sh's output directory")
+    ap.add_argument("--arrays", required=True,
+                    help="compare.py --arrays output: VIEW_mitsuba.npy and VIEW_cloud.npy")
+    ap.add_argument("--views", default=",".join(v[0] for v in C.VIEWS))
+    ap.add_argument("--width", type=int, default=80)
+    ap.add_argument("--height", type=int, default=60)
+    ap.add_argument("--supersample", type=int, default=4)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a [render] key for our renders (e.g. shadow_steps=32)")
+    ap.add_argument("--shipped", default="0.5,0.91,0.45,4.23",
+                    help="the gains to score first (MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, "
+                         "DIFFUSE_GAIN, AMBIENT_GAIN)")
+    a = ap.parse_args()
+    extra = dict(kv.split("=", 1) for kv in a.set)
+    data = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in a.views.split(","):
+            truth = np.load(os.path.join(a.arrays, f"{name}_mitsuba.npy"))
+            cloud = np.load(os.path.join(a.arrays, f"{name}_cloud.npy"))
+            imgs = {v: render(os.path.join(a.bins, f"cumulus_{v}"), name, a.width, a.height,
+                              a.supersample, extra, tmp)[cloud] for v in ["zero"] + PARTS}
+            parts = np.stack([imgs[v] - imgs["zero"] for v in PARTS], -1)
+            data[name] = (truth[cloud], imgs["zero"], parts)
+            print(f"{name}: rendered", flush=True)
+    shipped = np.array([float(x) for x in a.shipped.split(",")])
+    show("shipped", data, shipped)
+    X = np.concatenate([np.einsum("nck,c->nk", p, Y) / (t @ Y)[:, None]
+                        for t, z, p in data.values()])
+    yv = np.concatenate([((t - z) @ Y) / (t @ Y) for t, z, p in data.values()])
+    g_ls, *_ = np.linalg.lstsq(X, yv, rcond=None)
+    show("least squares", data, g_ls)
+    nm = {"maxiter": 4000, "xatol": 1e-4, "fatol": 1e-6}
+    fit = minimize(lambda g: sum(s[0] for s in scores(data, np.abs(g))), shipped,
+                   method="Nelder-Mead", options=nm)
+    show("per-pixel errors", data, np.abs(fit.x))
+    fit = minimize(lambda g: sum(s[0] + abs(np.log(s[3])) for s in scores(data, np.abs(g))),
+                   shipped, method="Nelder-Mead", options=nm)
+    show("per-pixel errors and colour", data, np.abs(fit.x))
+
+
+if __name__ == "__main__":
+    main()
