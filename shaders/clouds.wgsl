@@ -46,6 +46,8 @@ const SUN_DISK_COS: f32 = 0.999989;
 const WATER_F0: f32 = 0.0204;
 // The longest shadow ray toward the sun, m.
 const SHADOW_RAY_M: f32 = 12000.0;
+// SHADOW_STEPS steps per this many metres of shadow ray, at most
+// SHADOW_STEP_FACTOR_MAX times SHADOW_STEPS (shadow_step_count).
 const SHADOW_STEP_SPAN_M: f32 = 2000.0;
 const SHADOW_STEP_FACTOR_MAX: f32 = 3.0;
 // Multiple scattering and sky light (the CPU's lighting.rs, renderer.rs).

@@ -176,9 +176,9 @@ fn a_low_suns_shadow_ray_crosses_the_whole_band() {
     // From the band's bottom toward a sun 8° up, the light crosses 7.2 km
     // of a 1 km band. The shadow ray's optical depth must be that whole
     // path's, as a 100,000-point quadrature of the same density along it
-    // finds it: capped at 2 km (before 2026-12-03) it saw under a third.
-    // A wide footprint keeps the detail noise smooth, so the 60 steps'
-    // estimate is a quadrature too (tolerance 5 %).
+    // finds it: capped at 2 km (before 2026-12-03) it saw under half of
+    // it. A wide footprint keeps the detail noise smooth, so the 50-60
+    // steps' estimate is a quadrature too (tolerance 5 %).
     let cm = cloud_map();
     let p = ProjectedField::uniform(16, 16, [1.0, 1.0, 1.0]);
     let f = Fields {

@@ -28,6 +28,7 @@ from scipy.optimize import minimize
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import compare as C  # noqa: E402
+from surrogate import shipped_gains  # noqa: E402
 
 Y = np.array([0.2126, 0.7152, 0.0722])
 PARTS = ["mf", "mi", "di", "am"]
@@ -75,9 +76,7 @@ def main():
     ap.add_argument("--supersample", type=int, default=4)
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a [render] key for our renders (e.g. shadow_steps=32)")
-    ap.add_argument("--shipped", default="0.5,0.91,0.45,4.23",
-                    help="the gains to score first (MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, "
-                         "DIFFUSE_GAIN, AMBIENT_GAIN)")
+
     a = ap.parse_args()
     extra = dict(kv.split("=", 1) for kv in a.set)
     data = {}
@@ -90,7 +89,9 @@ def main():
             parts = np.stack([imgs[v] - imgs["zero"] for v in PARTS], -1)
             data[name] = (truth[cloud], imgs["zero"], parts)
             print(f"{name}: rendered", flush=True)
-    shipped = np.array([float(x) for x in a.shipped.split(",")])
+    # MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, DIFFUSE_GAIN, AMBIENT_GAIN,
+    # as the Rust source has them.
+    shipped = np.array(shipped_gains())
     show("shipped", data, shipped)
     X = np.concatenate([np.einsum("nck,c->nk", p, Y) / (t @ Y)[:, None]
                         for t, z, p in data.values()])

@@ -33,8 +33,8 @@ pub const SHADOW_RAY_M: f32 = 12_000.0;
 pub const SHADOW_STEP_SPAN_M: f32 = 2_000.0;
 
 /// The most steps a long shadow ray takes, as a multiple of
-/// `render.shadow_steps` (`SHADOW_STEP_FACTOR_MAX` in WGSL): the cost of
-/// a sun below about 20° is at most this many times a high sun's.
+/// `render.shadow_steps` (`SHADOW_STEP_FACTOR_MAX` in WGSL): however low
+/// the sun, a shadow ray costs at most this many times a high sun's.
 pub const SHADOW_STEP_FACTOR_MAX: f32 = 3.0;
 
 /// The length of the shadow ray from `p` toward the sun: to the band's
