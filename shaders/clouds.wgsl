@@ -63,8 +63,12 @@ const AMBIENT_GAIN: f32 = 4.23;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
 // Uniform steps of a ray the sea reflects, and its shadow samples.
-const REFLECTION_STEPS: u32 = 16u;
-const REFLECTION_SHADOW_STEPS: u32 = 4u;
+const REFLECTION_RAYS: u32 = 6u;
+const REFLECTION_STEPS: u32 = 4u;
+const REFLECTION_SHADOW_STEPS: u32 = 2u;
+const REFLECTION_MIN_ELEVATION: f32 = 0.01;
+// The golden ratio's fraction (the CPU's sampling::GOLDEN).
+const GOLDEN: f32 = 0.618034;
 // The clip depth at which rays are unprojected.
 const RAY_DEPTH: f32 = 0.5;
 
@@ -506,9 +510,22 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> v
     return ground_haze(surface, dir, sun_dir);
 }
 
-// The clouds the sea mirrors (rgb, premultiplied) and the reflected ray's
-// transmittance (a) where a ray that meets no terrain reaches it (the
-// CPU's `sea_reflection`).
+// The elevation (radians) of a ray the wind-roughened sea reflects where
+// the flat sea's mirror ray rises at `mirror`, at the quantile `u` of the
+// waves' slopes: a logistic of Cox and Munk's deviation, cut off below
+// REFLECTION_MIN_ELEVATION (the CPU's `reflected_elevation`).
+fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
+    let deviation = sqrt(2.0 * (0.003 + 0.00512 * max(wind_mps, 0.0)));
+    let s = deviation * sqrt(3.0) / PI;
+    let lowest = 1.0 / (1.0 + exp((mirror - REFLECTION_MIN_ELEVATION) / s));
+    let q = clamp(lowest + (1.0 - lowest) * u, 1e-6, 1.0 - 1e-6);
+    return mirror + s * log(q / (1.0 - q));
+}
+
+// The clouds the sea mirrors (rgb, premultiplied) and the reflected rays'
+// transmittance (a) where a ray that meets no terrain reaches it: the
+// mean of REFLECTION_RAYS reflected rays, one per stratum of the waves'
+// slopes shifted by the pixel's dither (the CPU's `sea_reflection`).
 fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec4f {
     if !SEA || dir.y >= 0.0 || origin.y <= 0.0 {
         return vec4f(0.0, 0.0, 0.0, 1.0);
@@ -518,17 +535,35 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
         return vec4f(0.0, 0.0, 0.0, 1.0);
     }
     let p = vec3f(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
-    let r = vec3f(dir.x, -dir.y, dir.z);
+    let across = normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(0.0, 0.0, 1.0));
+    let mirror = asin(clamp(-dir.y, -1.0, 1.0));
+    let step_dither = fract(dither + GOLDEN);
+    // What lights the mirrored clouds, the same for every reflected ray
+    // (the CPU's ReflectionLight).
+    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
+    let sky_top = sky_ambient(sun_dir) * 0.25;
+    let ground = ground_up(sun_dir, true) * 0.25;
+    let blur = 2.0 * sqrt(0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0));
+    var sum = vec4f(0.0);
+    for (var k = 0u; k < REFLECTION_RAYS; k++) {
+        let u = (f32(k) + dither) / f32(REFLECTION_RAYS);
+        let e = reflected_elevation(mirror, SEA_WIND_MPS, u);
+        let r = across * cos(e) + vec3f(0.0, sin(e), 0.0);
+        sum += reflected_clouds(p, r, t_sea, step_dither, sun_dir, sun, sky_top, ground, blur);
+    }
+    return sum / f32(REFLECTION_RAYS);
+}
+
+// The clouds along one ray `r` the sea reflects from `p`, `t_sea` from the
+// eye (rgb premultiplied, a its transmittance through the band): a
+// coarser twin of march_ray (the CPU's `reflected_clouds`).
+fn reflected_clouds(p: vec3f, r: vec3f, t_sea: f32, dither: f32, sun_dir: vec3f, sun: vec3f, sky_top: vec3f, ground: vec3f, blur: f32) -> vec4f {
     let seg = band_segment(p, r, frame.band.x, frame.band.y, frame.sun_light.w);
     if seg.y <= seg.x {
         return vec4f(0.0, 0.0, 0.0, 1.0);
     }
     let spread = frame.cam_pos.w;
-    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
-    let sky_top = sky_ambient(sun_dir) * 0.25;
-    let ground = ground_up(sun_dir, true) * 0.25;
     let cos_theta = dot(r, sun_dir);
-    let blur = 2.0 * sqrt(0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0));
     let h = (seg.y - seg.x) / f32(REFLECTION_STEPS);
     var transmittance = 1.0;
     var light = vec3f(0.0);

@@ -9,7 +9,8 @@ use cumulus::render::cpu::lighting::{
     SHADOW_STEP_SPAN_M, phase_dual, shadow_ray_length, sun_optical_depth, sun_transmittance,
 };
 use cumulus::render::cpu::renderer::{
-    ALBEDO, Frame, Quality, flat_ground_shadow, march_ray, render_linear, sea_reflection, to_srgb8,
+    ALBEDO, Frame, Quality, REFLECTION_MIN_ELEVATION, ReflectionLight, flat_ground_shadow,
+    march_ray, reflected_clouds, reflected_elevation, render_linear, sea_reflection, to_srgb8,
 };
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, SkyModel, background_radiance, sun_direction, sun_light_at,
@@ -528,4 +529,82 @@ fn the_sea_mirrors_the_clouds_above_it() {
         changed >= dimmed,
         "{changed} sea pixels changed by their reflection"
     );
+}
+
+/// The waves turn the reflected ray up and down: its elevation spreads
+/// about the mirror ray's with the deviation √(2 · mean square slope) of
+/// Cox and Munk's slopes (0.28 rad at 7 m/s, 0.077 on a calm sea), and
+/// never below the horizon.
+#[test]
+fn the_waves_spread_the_reflected_rays_elevation() {
+    let n = 20_000;
+    for (wind, deviation) in [
+        (7.0_f32, (2.0 * (0.003 + 0.00512 * 7.0_f32)).sqrt()),
+        (0.0, 0.077),
+    ] {
+        // A high mirror ray: the spread is whole, centred on it.
+        let mirror = 1.2;
+        let e: Vec<f32> = (0..n)
+            .map(|i| reflected_elevation(mirror, wind, (i as f32 + 0.5) / n as f32))
+            .collect();
+        let mean = e.iter().sum::<f32>() / n as f32;
+        let sd = (e.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / n as f32).sqrt();
+        assert!(
+            (mean - mirror).abs() < 0.01 * deviation,
+            "wind {wind}: mean {mean}"
+        );
+        assert!(
+            (sd / deviation - 1.0).abs() < 0.03,
+            "wind {wind}: {sd} vs {deviation}"
+        );
+        // It grows with the quantile.
+        assert!(e.windows(2).all(|w| w[1] >= w[0]));
+        // A grazing mirror ray: the waves send it up, none of it down.
+        for i in 0..n {
+            let low = reflected_elevation(0.005, wind, (i as f32 + 0.5) / n as f32);
+            assert!(
+                low >= REFLECTION_MIN_ELEVATION * 0.999,
+                "wind {wind}: {low}"
+            );
+        }
+    }
+}
+
+/// A rough sea mirrors clouds its flat mirror ray misses: looking down
+/// 0.3°, the mirror ray would reach the band 95 km out, beyond the 40 km
+/// the march goes; the waves' steeper rays meet the cloud layer, and it
+/// dims the mirrored sky. (One mirror ray, before the waves' spread, left
+/// these pixels bare.)
+#[test]
+fn a_rough_sea_mirrors_clouds_the_mirror_ray_misses() {
+    let cm = cloud_map();
+    let cloudy = ProjectedField::uniform(32, 32, [1.0, 0.8, 1.0]);
+    let mut fr = small_frame(&cloudy, &cm);
+    fr.quality.sea_wind_mps = Some(7.0);
+    let origin = Vec3::new(0.0, 100.0, 0.0);
+    let sun = sun_direction(40.0, 135.0);
+    let e = 0.3_f32.to_radians();
+    for a in [0.0_f32, 1.0, 2.0, 3.0] {
+        let dir = Vec3::new(e.cos() * a.sin(), -e.sin(), e.cos() * a.cos());
+        let t_sea = origin.y / e.sin();
+        let p = origin + dir * t_sea;
+        let mirror = Vec3::new(dir.x, -dir.y, dir.z);
+        assert_eq!(
+            reflected_clouds(
+                p,
+                mirror,
+                t_sea,
+                0.5,
+                sun,
+                &ReflectionLight::new(&fr, sun, 7.0),
+                1e-3,
+                &fr
+            ),
+            (Vec3::ZERO, 1.0),
+            "the mirror ray itself meets no cloud"
+        );
+        let (light, t) = sea_reflection(origin, dir, 0.5, sun, 1e-3, &fr);
+        assert!(t < 0.9, "azimuth {a}: transmittance {t}");
+        assert!(light.min_element() > 0.0, "azimuth {a}: {light}");
+    }
 }

@@ -128,7 +128,13 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             sky_luts::AERIAL_PERSPECTIVE_STEPS as f64,
         ),
         ("LIMB_DARKENING_U", sky_luts::LIMB_DARKENING_U as f64),
+        ("REFLECTION_RAYS", renderer::REFLECTION_RAYS as f64),
         ("REFLECTION_STEPS", renderer::REFLECTION_STEPS as f64),
+        (
+            "REFLECTION_MIN_ELEVATION",
+            renderer::REFLECTION_MIN_ELEVATION as f64,
+        ),
+        ("GOLDEN", cumulus::render::sampling::GOLDEN as f64),
         (
             "REFLECTION_SHADOW_STEPS",
             renderer::REFLECTION_SHADOW_STEPS as f64,

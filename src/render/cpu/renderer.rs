@@ -5,6 +5,7 @@
 
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
+use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
@@ -15,7 +16,7 @@ use super::sky::{
 use super::sky_luts::SkyLuts;
 pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
 use crate::render::camera::View;
-use crate::render::sampling::{self, frame_offset, jitter};
+use crate::render::sampling::{self, GOLDEN, frame_offset, jitter};
 use crate::render::terrain::Heightfield;
 
 /// Quality and look (scene table `[render]` keys that are not camera,
@@ -290,9 +291,7 @@ pub fn terrain_radiance(
     let light = &fr.sky_light();
     let sun = sun_light_at(light, p.y, sun_dir);
     let sky = sky_ambient(light, sun_dir);
-    let lit = albedo
-        * (sun * (n.dot(sun_dir).max(0.0) * shadow / std::f32::consts::PI)
-            + sky * (0.5 + 0.5 * n.y));
+    let lit = albedo * (sun * (n.dot(sun_dir).max(0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
     let (inscatter, haze) = aerial(light, dir, t, sun_dir);
     lit * haze + inscatter
 }
@@ -314,28 +313,54 @@ pub fn flat_ground_shadow(origin: Vec3, dir: Vec3, sun_dir: Vec3, fr: &Frame) ->
     cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS, &fr.fields, &fr.density)
 }
 
-/// Uniform steps of the march of a ray the sea reflects
+/// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
+/// per stratum of the waves' slopes ([`reflected_elevation`]).
+pub const REFLECTION_RAYS: u32 = 6;
+/// Uniform steps of the march of each reflected ray
 /// (`REFLECTION_STEPS` in WGSL).
-pub const REFLECTION_STEPS: u32 = 16;
+pub const REFLECTION_STEPS: u32 = 4;
 /// Samples of each of its steps' shadow rays (`REFLECTION_SHADOW_STEPS`).
-pub const REFLECTION_SHADOW_STEPS: u32 = 4;
+pub const REFLECTION_SHADOW_STEPS: u32 = 2;
+/// The lowest elevation (radians, about 0.6°) a wave sends a reflected
+/// ray to; the facets that would send it lower are hidden behind the
+/// next wave at the grazing angles where that happens.
+pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
+
+/// The elevation (radians) of a ray the wind-roughened sea reflects,
+/// where the flat sea's mirror ray rises at `mirror` radians, at the
+/// quantile `u` in `(0, 1)` of the waves' slopes.
+///
+/// A facet tilted by a slope `s` toward or away from the viewer turns
+/// the reflected ray up or down by `2 s` (sideways tilts turn it in
+/// azimuth, by far less at the grazing angles where a sea's reflection
+/// shows). Cox and Munk's (1954) mean square slope `0.003 + 0.00512 U`
+/// for a wind of `U` m/s is split between the two directions, so the
+/// elevation spreads with a standard deviation of `√(2 · that)`: 0.28 rad
+/// (16°) at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
+/// distribution of that deviation (its quantile in closed form, a
+/// Gaussian's shape within a few percent), cut off below
+/// [`REFLECTION_MIN_ELEVATION`]: the waves draw a mirrored cloud out
+/// into a vertical smear, and only upward.
+#[inline]
+pub fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
+    let deviation = (2.0 * (0.003 + 0.00512 * wind_mps.max(0.0))).sqrt();
+    // A logistic of scale s has the deviation s·π/√3.
+    let s = deviation * 3f32.sqrt() / PI;
+    let lowest = 1.0 / (1.0 + ((mirror - REFLECTION_MIN_ELEVATION) / s).exp());
+    let q = (lowest + (1.0 - lowest) * u).clamp(1e-6, 1.0 - 1e-6);
+    mirror + s * (q / (1.0 - q)).ln()
+}
 
 /// The clouds mirrored by the sea where a ray that meets no terrain
 /// reaches it (y = 0; the flat mean surface, as the sky's reflection):
-/// (their light, premultiplied; the transmittance of the reflected ray
-/// through the band). The reflected ray is marched across the band in
-/// [`REFLECTION_STEPS`] uniform steps, each sample placed in its step by
-/// the pixel's `dither` as the view ray's are (fine grain, not bands of
-/// rows that sample the same depths), each lit sample
-/// by the sun through [`cloud_shadow`] with [`REFLECTION_SHADOW_STEPS`]
-/// samples (the octaves as in the clouds' own light) and by the sky's
-/// and the ground's ambient: a coarser twin of [`march_ray`], for a
-/// reflection the Fresnel factor dims to a few percent looking down. The
-/// clouds are read at the level of detail of the waves' blur, twice the
-/// Cox-Munk slopes' deviation times the distance (0.4 rad at 7 m/s): a
-/// wind-roughened sea mirrors soft clouds, and 16 samples do not alias.
-/// `(0, 1)` over land, with the camera under the ground, or when the sea
-/// lies beyond `max_distance_m`.
+/// (their light, premultiplied; the transmittance of the reflected rays
+/// through the band). The waves scatter the mirror image up and down
+/// ([`reflected_elevation`]), so the pixel averages [`REFLECTION_RAYS`]
+/// reflected rays, one in each stratum of the slopes' distribution (the
+/// strata shifted by the pixel's `dither`, so neighbouring pixels and
+/// TSAA frames fill in between them), each [`reflected_clouds`]. `(0, 1)`
+/// over land, with the camera under the ground, or when the sea lies
+/// beyond `max_distance_m`.
 pub fn sea_reflection(
     origin: Vec3,
     dir: Vec3,
@@ -345,7 +370,6 @@ pub fn sea_reflection(
     fr: &Frame,
 ) -> (Vec3, f32) {
     let q = &fr.quality;
-    let d = &fr.density;
     let Some(wind) = q.sea_wind_mps else {
         return (Vec3::ZERO, 1.0);
     };
@@ -357,19 +381,93 @@ pub fn sea_reflection(
         return (Vec3::ZERO, 1.0);
     }
     let p = Vec3::new(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
-    let r = Vec3::new(dir.x, -dir.y, dir.z);
+    let across = Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::Z);
+    let mirror = (-dir.y).clamp(-1.0, 1.0).asin();
+    // The steps' placement within a ray, apart from the strata's shift.
+    let step_dither = (dither + GOLDEN).fract();
+    let light_in = ReflectionLight::new(fr, sun_dir, wind);
+    let mut light = Vec3::ZERO;
+    let mut transmittance = 0.0;
+    for k in 0..REFLECTION_RAYS {
+        let u = (k as f32 + dither) / REFLECTION_RAYS as f32;
+        let e = reflected_elevation(mirror, wind, u);
+        let r = across * e.cos() + Vec3::Y * e.sin();
+        let (l, t) = reflected_clouds(p, r, t_sea, step_dither, sun_dir, &light_in, spread, fr);
+        light += l;
+        transmittance += t;
+    }
+    let n = REFLECTION_RAYS as f32;
+    (light / n, transmittance / n)
+}
+
+/// What lights the clouds a sea pixel mirrors, the same for each of its
+/// reflected rays (computed once in [`sea_reflection`]; arguments of
+/// `reflected_clouds` in WGSL): the sun at the band's middle, the
+/// sky's and the ground's ambient, and the waves' sideways blur (radians).
+#[derive(Debug, Clone, Copy)]
+pub struct ReflectionLight {
+    /// The sun's light at the band's middle.
+    pub sun: Vec3,
+    /// The upper sky's ambient ([`ambient_light`]'s `sky_top`).
+    pub sky_top: Vec3,
+    /// The sea's light from below ([`ambient_light`]'s `ground`).
+    pub ground: Vec3,
+    /// Twice the Cox-Munk slopes' deviation, radians: the level of
+    /// detail the mirrored clouds are read at, per metre of distance.
+    pub blur: f32,
+}
+
+impl ReflectionLight {
+    /// The light of `fr` under a sun along `sun_dir`, over a sea in a
+    /// wind of `wind_mps`.
+    pub fn new(fr: &Frame, sun_dir: Vec3, wind_mps: f32) -> Self {
+        let sky = &fr.sky_light();
+        let d = &fr.density;
+        Self {
+            sun: sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir),
+            sky_top: sky_ambient(sky, sun_dir) * 0.25,
+            ground: ground_up(sky, sun_dir, true) * 0.25,
+            blur: 2.0 * (0.003 + 0.00512 * wind_mps.max(0.0)).sqrt(),
+        }
+    }
+}
+
+/// The clouds along one ray `r` the sea reflects from `p`, `t_sea` from
+/// the eye: (their light, premultiplied; the ray's transmittance through
+/// the band). The ray is marched across the band in
+/// [`REFLECTION_STEPS`] uniform steps, each sample placed in its step by
+/// `dither` (fine grain, not bands of rows that sample the same depths),
+/// each lit sample by the sun through [`cloud_shadow`] with
+/// [`REFLECTION_SHADOW_STEPS`] samples (the octaves as in the clouds' own
+/// light) and by the sky's and the ground's ambient (`light`): a coarser
+/// twin of [`march_ray`], for a reflection the Fresnel factor dims to a
+/// few percent looking down. The clouds are read at the level of detail
+/// of twice the Cox-Munk slopes' deviation times the distance
+/// (`light_in.blur`): a rough sea mirrors soft clouds, and a few samples
+/// do not alias.
+#[allow(clippy::too_many_arguments)]
+pub fn reflected_clouds(
+    p: Vec3,
+    r: Vec3,
+    t_sea: f32,
+    dither: f32,
+    sun_dir: Vec3,
+    light_in: &ReflectionLight,
+    spread: f32,
+    fr: &Frame,
+) -> (Vec3, f32) {
+    let q = &fr.quality;
+    let d = &fr.density;
     let Some((t0, t1)) = band_segment(p, r, d.band_bottom_m, d.band_top_m, q.max_distance_m) else {
         return (Vec3::ZERO, 1.0);
     };
-    let sky = &fr.sky_light();
-    let sun = sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir);
-    let sky_top = sky_ambient(sky, sun_dir) * 0.25;
-    let ground = ground_up(sky, sun_dir, true) * 0.25;
+    let ReflectionLight {
+        sun,
+        sky_top,
+        ground,
+        blur,
+    } = *light_in;
     let cos = r.dot(sun_dir);
-    // The waves spread the mirrored rays over twice the slopes' standard
-    // deviation (Cox and Munk, as the glint's): the clouds are read at
-    // that blur's level of detail, as a rough sea shows them.
-    let blur = 2.0 * (0.003 + 0.00512 * wind.max(0.0)).sqrt();
     let h = (t1 - t0) / REFLECTION_STEPS as f32;
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
