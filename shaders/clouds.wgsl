@@ -80,7 +80,7 @@ struct Frame {
     screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
-    exposure: vec4f,     // exposure before the tone map, unused, unused, unused
+    exposure: vec4f,     // exposure before the tone map, 1 when the cloud layer carries the sea's mirrored clouds (else 0), unused, unused
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
@@ -494,8 +494,7 @@ fn water_light(sun: vec3f, sun_dir: vec3f) -> vec3f {
 fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> vec3f {
     let mu = max(-dir.y, 1e-3);
     let f = fresnel_water(mu);
-    let mirrored_sky = sky_above(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
-    let reflected = reflection.rgb + mirrored_sky * reflection.a;
+    let reflected = reflection.rgb + mirrored_sky(dir, sun_dir) * reflection.a;
     let sun = sun_light_at(0.0, sun_dir) * shadow;
     let variance = 0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0);
     let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
@@ -520,6 +519,24 @@ fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
     let lowest = 1.0 / (1.0 + exp((mirror - REFLECTION_MIN_ELEVATION) / s));
     let q = clamp(lowest + (1.0 - lowest) * u, 1e-6, 1.0 - 1e-6);
     return mirror + s * log(q / (1.0 - q));
+}
+
+// The sky the flat sea mirrors along `dir` (the CPU's `mirrored_sky`).
+fn mirrored_sky(dir: vec3f, sun_dir: vec3f) -> vec3f {
+    let mu = max(-dir.y, 1e-3);
+    return sky_above(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+}
+
+// What the clouds the sea mirrors change in a sea pixel's radiance: the sea
+// with them less without them (the CPU's `sea_reflection_change`). The
+// cloud pass adds it to the cloud layer, so TSAA accumulates it.
+fn sea_reflection_change(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec3f {
+    let r = sea_reflection(origin, dir, dither, sun_dir);
+    if r.a >= 1.0 && all(r.rgb == vec3f(0.0)) {
+        return vec3f(0.0);
+    }
+    let f = fresnel_water(max(-dir.y, 1e-3));
+    return (r.rgb - mirrored_sky(dir, sun_dir) * (1.0 - r.a)) * f * ground_haze_transmittance(dir, sun_dir);
 }
 
 // The clouds the sea mirrors (rgb, premultiplied) and the reflected rays'
@@ -843,12 +860,18 @@ fn is_geometry(z: f32) -> bool {
     return z != frame.screen.z;
 }
 
-// The march of one pixel at fragment position `pos` up to `max_t`.
-fn cloud_pixel(pos: vec2f, max_t: f32) -> CloudSample {
+// The march of one pixel at fragment position `pos` up to `max_t`; with
+// `sea`, the change the clouds the sea mirrors make to the sea behind,
+// under the clouds' transmittance.
+fn cloud_pixel(pos: vec2f, max_t: f32, sea: bool) -> CloudSample {
     let px = vec2u(pos);
     let dir = camera_ray(pos + frame.jitter.xy);
     let dither = fract(pixel_dither(px.x, px.y) + frame.jitter.z);
     var s = march_ray(frame.cam_pos.xyz, dir, dither, max_t);
+    if SEA && sea && frame.exposure.y > 0.5 {
+        let change = sea_reflection_change(frame.cam_pos.xyz, dir, dither, frame.sun_dir.xyz);
+        s.premultiplied = vec4f(s.premultiplied.rgb + (1.0 - s.premultiplied.a) * change, s.premultiplied.a);
+    }
     if DEBUG_COUNT {
         s.premultiplied = vec4f(f32(s.samples), 0.0, 0.0, 0.0);
     }

@@ -40,8 +40,7 @@ fn sky_background(pos: vec2f) -> vec3f {
     let dir = camera_ray(pos);
     let sun_dir = frame.sun_dir.xyz;
     let eye = frame.cam_pos.xyz;
-    // The cloud pass's dither for this pixel and frame.
-    let dither = fract(pixel_dither(u32(pos.x), u32(pos.y)) + frame.jitter.z);
-    let reflection = sea_reflection(eye, dir, dither, sun_dir);
-    return background_radiance(dir, sun_dir, flat_ground_shadow(eye, dir, sun_dir), reflection);
+    // The clouds the sea mirrors are in the cloud layer (the cloud pass's
+    // sea_reflection_change, accumulated by TSAA): the sea here is bare.
+    return background_radiance(dir, sun_dir, flat_ground_shadow(eye, dir, sun_dir), vec4f(0.0, 0.0, 0.0, 1.0));
 }

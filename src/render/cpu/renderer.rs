@@ -10,8 +10,8 @@ use std::f32::consts::PI;
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
 use super::sky::{
-    AtmosphereConfig, SkyLight, aerial, background_radiance, ground_up, sky_ambient, sun_direction,
-    sun_light_at,
+    AtmosphereConfig, SkyLight, aerial, background_radiance, fresnel_water,
+    ground_haze_transmittance, ground_up, mirrored_sky, sky_ambient, sun_direction, sun_light_at,
 };
 use super::sky_luts::SkyLuts;
 pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
@@ -171,8 +171,8 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
                 sun_dir,
                 q.sea_wind_mps,
                 flat_ground_shadow(origin, dir, sun_dir, fr),
-                sea_reflection(origin, dir, dither, sun_dir, spread, fr),
-            ),
+                (Vec3::ZERO, 1.0),
+            ) + sea_reflection_change(origin, dir, dither, sun_dir, spread, fr),
             q.max_distance_m,
         ),
     };
@@ -430,6 +430,34 @@ impl ReflectionLight {
             blur: 2.0 * (0.003 + 0.00512 * wind_mps.max(0.0)).sqrt(),
         }
     }
+}
+
+/// What the clouds the sea mirrors ([`sea_reflection`]) change in the
+/// radiance of a sea pixel along `dir`: [`super::sky::sea_radiance`] with them less
+/// without them, `(L - S (1 - T)) · F · T_air` for the clouds' light `L`
+/// and transmittance `T`, the mirrored sky `S` ([`mirrored_sky`]), the
+/// Fresnel factor `F` and the air's transmittance `T_air`
+/// ([`ground_haze_transmittance`]); zero where nothing is mirrored.
+/// The GPU adds it to the cloud layer in the cloud pass (under the
+/// clouds' transmittance), so TSAA accumulates the reflection's grain
+/// with the clouds', and the composite draws the sea without it.
+pub fn sea_reflection_change(
+    origin: Vec3,
+    dir: Vec3,
+    dither: f32,
+    sun_dir: Vec3,
+    spread: f32,
+    fr: &Frame,
+) -> Vec3 {
+    let (light, transmittance) = sea_reflection(origin, dir, dither, sun_dir, spread, fr);
+    if transmittance >= 1.0 && light == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let sky = &fr.sky_light();
+    let f = fresnel_water((-dir.y).max(1e-3));
+    (light - mirrored_sky(sky, dir, sun_dir) * (1.0 - transmittance))
+        * f
+        * ground_haze_transmittance(sky, dir, sun_dir)
 }
 
 /// The clouds along one ray `r` the sea reflects from `p`, `t_sea` from

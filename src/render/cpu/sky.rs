@@ -238,6 +238,18 @@ pub fn ground_haze(sky: &SkyLight, surface: Vec3, dir: Vec3, sun_dir: Vec3) -> V
     }
 }
 
+/// What of the ground's own light along `dir` (pointing down) comes
+/// through the air to the eye, per channel: the factor on `surface` in
+/// [`ground_haze`], which is affine in it.
+#[inline]
+pub fn ground_haze_transmittance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    let mu = (-dir.y).max(1e-4);
+    match sky.luts {
+        Some(_) => aerial(sky, dir, sky.camera_altitude_m.max(1.0) / mu, sun_dir).1,
+        None => Vec3::splat(1.0 - (-mu * 40.0).exp()),
+    }
+}
+
 /// The flat land's albedo (inlined in WGSL's `land_radiance`): a muted
 /// green-brown of fields, woods and soil seen from afar, greyer than the
 /// terrain's grass (0.07 / 0.11 / 0.04 on level ground), which lit at
@@ -347,6 +359,17 @@ fn water_light(sky: &SkyLight, sun: Vec3, sun_dir: Vec3) -> Vec3 {
     Vec3::new(0.004, 0.012, 0.02) * (sun * (sun_dir.y.max(0.0) / PI) + sky_ambient(sky, sun_dir))
 }
 
+/// The sky the flat sea mirrors along `dir` (pointing down).
+#[inline]
+pub fn mirrored_sky(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
+    let mu = (-dir.y).max(1e-3);
+    sky_above(
+        sky,
+        Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y),
+        sun_dir,
+    )
+}
+
 /// Radiance of a wind-roughened sea seen along `dir` (pointing down):
 /// - the sky reflected by the mean flat surface, weighted by
 ///   [`fresnel_water`] (so the sea darkens looking down and mirrors the
@@ -374,12 +397,7 @@ pub fn sea_radiance(
 ) -> Vec3 {
     let mu = (-dir.y).max(1e-3);
     let f = fresnel_water(mu);
-    let mirrored_sky = sky_above(
-        sky,
-        Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y),
-        sun_dir,
-    );
-    let reflected = reflection.0 + mirrored_sky * reflection.1;
+    let reflected = reflection.0 + mirrored_sky(sky, dir, sun_dir) * reflection.1;
     let sun = sun_light_at(sky, 0.0, sun_dir) * shadow;
     let variance = 0.003 + 0.00512 * wind_mps.max(0.0);
     let h = (sun_dir - dir).normalize_or(Vec3::Y);

@@ -403,7 +403,7 @@ impl CloudRenderer {
         self.check_target(target)?;
         self.check_depth(depth)?;
         let view = self.view_of(camera);
-        self.write_uniforms(&view, self.terrain.is_some());
+        self.write_uniforms(&view, self.terrain.is_some(), true);
         let constants = self.settings.constants();
         // A handle (wgpu objects are reference-counted), so `self` stays free.
         let timestamps = self.timestamps.clone();
@@ -485,7 +485,7 @@ impl CloudRenderer {
         }
         self.check_depth(depth)?;
         let view = self.view_of(camera);
-        self.write_uniforms(&view, false);
+        self.write_uniforms(&view, false, false);
         let constants = self.settings.constants();
         // A handle (wgpu objects are reference-counted), so `self` stays free.
         let timestamps = self.timestamps.clone();
@@ -564,7 +564,7 @@ impl CloudRenderer {
     /// history, and TSAA jitters the rays); `own_depth`: the cloud pass
     /// reads the terrain's depth buffer (stored flipped under reversed
     /// depth).
-    fn write_uniforms(&mut self, view: &View, own_depth: bool) {
+    fn write_uniforms(&mut self, view: &View, own_depth: bool, sea_in_layer: bool) {
         if let Some(sky) = &mut self.inputs.sky {
             // The sky view for this camera's altitude, submitted now (before
             // the caller's encoder); nothing is built unless the sun's
@@ -604,6 +604,7 @@ impl CloudRenderer {
             p_size: self.inputs.p_size,
             mask: self.inputs.mask_info,
             map_size: self.inputs.map_size,
+            sea_in_layer,
         });
         self.queue
             .write_buffer(&self.inputs.uniforms, 0, bytemuck::bytes_of(&u));

@@ -55,14 +55,14 @@ pub fn cloud_pass(depth: bool, tsaa: bool, physical: bool) -> String {
         "@location(0) vec4f"
     };
     s.push_str(&format!(
-        "\n@fragment\nfn fs_clouds(@builtin(position) pos: vec4f) -> {out} {{\n    var max_t = frame.sun_light.w;\n"
+        "\n@fragment\nfn fs_clouds(@builtin(position) pos: vec4f) -> {out} {{\n    var max_t = frame.sun_light.w;\n    var sea = true;\n"
     ));
     if depth {
         s.push_str(
-            "    let z = view_depth(textureLoad(depth_tex, vec2i(pos.xy), 0));\n    if is_geometry(z) {\n        max_t = min(max_t, depth_to_distance(z, pos.xy));\n    }\n",
+            "    let z = view_depth(textureLoad(depth_tex, vec2i(pos.xy), 0));\n    if is_geometry(z) {\n        max_t = min(max_t, depth_to_distance(z, pos.xy));\n        sea = false;\n    }\n",
         );
     }
-    s.push_str("    let c = cloud_pixel(pos.xy, max_t);\n");
+    s.push_str("    let c = cloud_pixel(pos.xy, max_t, sea);\n");
     if tsaa {
         s.push_str("    return CloudOut(c.premultiplied, c.distance);\n}\n");
     } else {

@@ -118,6 +118,7 @@ impl StandalonePass {
             p_size: [1, 1],
             mask: [1, 1, 1, 0],
             map_size: 1,
+            sea_in_layer: false,
         });
         self.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));

@@ -64,6 +64,10 @@ pub struct FrameInputs {
     pub mask: [u32; 4],
     /// Texels per side of the cloud map.
     pub map_size: u32,
+    /// The cloud pass adds the clouds the sea mirrors to the cloud layer,
+    /// for the composite's sea ([`crate::render::gpu::CloudRenderer::render`]);
+    /// not in an engine's clouds-only layer, drawn over its own ground.
+    pub sea_in_layer: bool,
 }
 
 impl FrameUniforms {
@@ -86,7 +90,7 @@ impl FrameUniforms {
             ],
             sun_dir: v4(sun_dir, q.haze_distance_m),
             sun_light: v4(sun, q.max_distance_m),
-            exposure: [q.exposure, 0.0, 0.0, 0.0],
+            exposure: [q.exposure, if i.sea_in_layer { 1.0 } else { 0.0 }, 0.0, 0.0],
             band: [
                 d.band_bottom_m,
                 d.band_top_m,
