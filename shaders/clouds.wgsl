@@ -62,7 +62,8 @@ const DIFFUSE_DEPTH_M: f32 = 100.0;
 const AMBIENT_GAIN: f32 = 4.23;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
-// Uniform steps of a ray the sea reflects, and its shadow samples.
+// The sea's reflection: reflected rays a pixel, the uniform steps of each
+// and their shadow samples, the lowest elevation the waves send one to.
 const REFLECTION_RAYS: u32 = 6u;
 const REFLECTION_STEPS: u32 = 4u;
 const REFLECTION_SHADOW_STEPS: u32 = 2u;

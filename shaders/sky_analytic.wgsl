@@ -41,7 +41,6 @@ fn aerial(dir: vec3f, distance_m: f32, sun_dir: vec3f) -> Aerial {
     return Aerial(analytic_sky(up, sun_dir) * (1.0 - haze), vec3f(haze));
 }
 
-// Faded into the horizon's sky within a few degrees of it.
 // The factor on the ground's own light in ground_haze (the CPU's
 // `ground_haze_transmittance`).
 fn ground_haze_transmittance(dir: vec3f, sun_dir: vec3f) -> vec3f {
@@ -49,6 +48,7 @@ fn ground_haze_transmittance(dir: vec3f, sun_dir: vec3f) -> vec3f {
     return vec3f(1.0 - exp(-mu * 40.0));
 }
 
+// Faded into the horizon's sky within a few degrees of it.
 fn ground_haze(surface: vec3f, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let mu = max(-dir.y, 1e-4);
     let horizon = analytic_sky(normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(1.0, 0.0, 0.0)), sun_dir);

@@ -40,7 +40,6 @@ fn aerial(dir: vec3f, distance_m: f32, sun_dir: vec3f) -> Aerial {
     return Aerial(s.inscatter, s.transmittance);
 }
 
-// The air from the camera down to the ground.
 // The factor on the ground's own light in ground_haze (the CPU's
 // `ground_haze_transmittance`).
 fn ground_haze_transmittance(dir: vec3f, sun_dir: vec3f) -> vec3f {
@@ -48,6 +47,7 @@ fn ground_haze_transmittance(dir: vec3f, sun_dir: vec3f) -> vec3f {
     return aerial(dir, max(frame.cam_pos.y, 1.0) / mu, sun_dir).transmittance;
 }
 
+// The air from the camera down to the ground.
 fn ground_haze(surface: vec3f, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let mu = max(-dir.y, 1e-4);
     let a = aerial(dir, max(frame.cam_pos.y, 1.0) / mu, sun_dir);

@@ -22,8 +22,12 @@ const W: u32 = 96;
 const H: u32 = 64;
 
 fn prepared() -> (Scene, Prepared) {
-    let mut sc =
-        Scene::load(std::path::Path::new("scenes/fair_weather.toml")).expect("shipped scene");
+    prepared_scene("fair_weather")
+}
+
+fn prepared_scene(name: &str) -> (Scene, Prepared) {
+    let path = format!("scenes/{name}.toml");
+    let mut sc = Scene::load(std::path::Path::new(&path)).expect("shipped scene");
     sc.render.tsaa = false;
     sc.render.width = W;
     sc.render.height = H;
@@ -262,16 +266,24 @@ fn every_depth_convention_hides_the_same_clouds() {
 /// (`rgb + (1 - a) · sky`, the ground in the clouds' shadows below the
 /// horizon, tone-mapped) is the renderer's own composite:
 /// the output is linear, premultiplied, and leaves the background out.
+/// Over land and over the sea (BOMEX), whose mirrored clouds `render`
+/// draws in the cloud pass and the clouds-only layer must leave out.
 #[test]
 fn the_clouds_only_layer_composites_to_the_renderers_picture() {
     let Some(ctx) = gpu() else { return };
-    let (sc, p) = prepared();
-    let mut c = renderer(&ctx, &sc, &p);
+    for name in ["fair_weather", "bomex"] {
+        clouds_only_layer_composites(&ctx, name);
+    }
+}
+
+fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
+    let (sc, p) = prepared_scene(name);
+    let mut c = renderer(ctx, &sc, &p);
     let r = &sc.render;
     let view = r
         .camera()
         .view(W as f32 / H as f32, r.quality().max_distance_m);
-    let layer = clouds_only(&ctx, &mut c, None, &view);
+    let layer = clouds_only(ctx, &mut c, None, &view);
     let target = textures::create_2d(
         &ctx.device,
         "app.target",
@@ -334,7 +346,7 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
         .filter(|(a, b)| a.abs_diff(**b) > 2)
         .count();
     eprintln!(
-        "worst {worst} levels, {off} of {} channels off by > 2",
+        "{name}: worst {worst} levels, {off} of {} channels off by > 2",
         ours.len()
     );
     // Half floats (10-bit mantissa) and the GPU's exp: two 8-bit levels,
@@ -347,7 +359,15 @@ fn the_clouds_only_layer_composites_to_the_renderers_picture() {
         off as f64 <= 0.002 * ours.len() as f64,
         "{off} channels differ by more than 2 levels"
     );
-    assert!(worst <= 8, "composite differs by {worst} levels");
+    // Over the sea, each pixel's 6 reflected rays take 4 steps each
+    // across kilometres of band; where one of them grazes a cloud's edge
+    // the twins can disagree on it, as the parity tests allow on single
+    // pixels (measured on lavapipe: one BOMEX pixel, 22 levels).
+    let allowed = if name == "bomex" { 64 } else { 8 };
+    assert!(
+        worst <= allowed,
+        "{name}: composite differs by {worst} levels"
+    );
     // And it is not the composite itself: no sky in the clear pixels (the
     // sky's radiance is 0.1-1 here; a wisp of opacity under 1e-3 carries
     // at most a few thousandths).

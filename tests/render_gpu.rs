@@ -116,8 +116,8 @@ fn gpu_matches_cpu_reference_from_the_ground() {
 }
 
 /// The sea (BOMEX's ground) with the sun's glint, the reflected sky and
-/// the horizon in view: the composite's `background_radiance` against the
-/// CPU's.
+/// the horizon in view: the composite's `background_radiance` and the
+/// cloud pass's `sea_reflection_change` against the CPU's.
 #[test]
 fn gpu_matches_cpu_reference_over_the_sea() {
     let Some(ctx) = gpu() else { return };
@@ -480,7 +480,9 @@ fn tsaa_smooths_the_seas_reflection() {
         &sea_rows(&hl.read_rgb8(&ctx).expect("readback")),
     );
     eprintln!("the sea against the oracle: 1 frame {one:.5}, 32 frames {many:.5}");
-    assert!(many < 0.5 * one, "1 frame {one}, 32 frames {many}");
+    // Measured on lavapipe: 0.0094 -> 0.0040 (0.43); drawn after TSAA, the
+    // sea stayed at 0.0091 (0.99).
+    assert!(many < 0.7 * one, "1 frame {one}, 32 frames {many}");
 }
 
 /// What a user sees after TSAA with a static camera, at the default 48

@@ -337,10 +337,10 @@ pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
 /// for a wind of `U` m/s is split between the two directions, so the
 /// elevation spreads with a standard deviation of `√(2 · that)`: 0.28 rad
 /// (16°) at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
-/// distribution of that deviation (its quantile in closed form, a
-/// Gaussian's shape within a few percent), cut off below
+/// distribution of that deviation (its quantile in closed form; its
+/// cumulative distribution within 0.02 of a Gaussian's), cut off below
 /// [`REFLECTION_MIN_ELEVATION`]: the waves draw a mirrored cloud out
-/// into a vertical smear, and only upward.
+/// into a vertical smear, near the horizon only upward.
 #[inline]
 pub fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
     let deviation = (2.0 * (0.003 + 0.00512 * wind_mps.max(0.0))).sqrt();
@@ -413,7 +413,8 @@ pub struct ReflectionLight {
     /// The sea's light from below ([`ambient_light`]'s `ground`).
     pub ground: Vec3,
     /// Twice the Cox-Munk slopes' deviation, radians: the level of
-    /// detail the mirrored clouds are read at, per metre of distance.
+    /// detail the mirrored clouds are read at, per metre of distance
+    /// (against aliasing; [`reflected_clouds`]).
     pub blur: f32,
 }
 
@@ -437,7 +438,10 @@ impl ReflectionLight {
 /// without them, `(L - S (1 - T)) · F · T_air` for the clouds' light `L`
 /// and transmittance `T`, the mirrored sky `S` ([`mirrored_sky`]), the
 /// Fresnel factor `F` and the air's transmittance `T_air`
-/// ([`ground_haze_transmittance`]); zero where nothing is mirrored.
+/// ([`ground_haze_transmittance`]); zero where nothing is mirrored. The
+/// sky `S` the clouds hide is the flat mirror's, though the reflected
+/// rays that meet them rise higher: near the horizon, where the mirrored
+/// sky is brightest, the change is somewhat too dark.
 /// The GPU adds it to the cloud layer in the cloud pass (under the
 /// clouds' transmittance), so TSAA accumulates the reflection's grain
 /// with the clouds', and the composite draws the sea without it.
@@ -467,12 +471,15 @@ pub fn sea_reflection_change(
 /// `dither` (fine grain, not bands of rows that sample the same depths),
 /// each lit sample by the sun through [`cloud_shadow`] with
 /// [`REFLECTION_SHADOW_STEPS`] samples (the octaves as in the clouds' own
-/// light) and by the sky's and the ground's ambient (`light`): a coarser
+/// light) and by the sky's and the ground's ambient (`light_in`): a coarser
 /// twin of [`march_ray`], for a reflection the Fresnel factor dims to a
 /// few percent looking down. The clouds are read at the level of detail
 /// of twice the Cox-Munk slopes' deviation times the distance
-/// (`light_in.blur`): a rough sea mirrors soft clouds, and a few samples
-/// do not alias.
+/// (`light_in.blur`), so that 4 samples across the band do not alias.
+/// That blurs sideways too, more than the waves do at the grazing angles
+/// where reflections show (a sideways tilt `s` turns the ray by about
+/// `2 s tan(elevation)` in azimuth): a choice against aliasing, not the
+/// waves' own blur.
 #[allow(clippy::too_many_arguments)]
 pub fn reflected_clouds(
     p: Vec3,

@@ -382,8 +382,8 @@ pub fn mirrored_sky(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
 ///
 /// then seen through the air as the land is ([`ground_haze`]). The
 /// clouds' `shadow` (transmittance toward the sun) dims the glint and the
-/// sunlit part of the water. `reflection` is the clouds the mean surface
-/// mirrors (their premultiplied light and transmittance,
+/// sunlit part of the water. `reflection` is the clouds the waves
+/// mirror (their premultiplied light and transmittance,
 /// `renderer::sea_reflection`; `(0, 1)`: none), in front of the mirrored
 /// sky.
 #[inline]

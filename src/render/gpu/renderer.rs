@@ -370,7 +370,10 @@ impl CloudRenderer {
 
     /// The cloud layer of the last frame (premultiplied radiance, opacity;
     /// or the sample counts with `debug_sample_count`), for debug views and
-    /// tests. `None` while the size is zero (nothing is drawn).
+    /// tests. After [`Self::render`] over the sea, its radiance also holds
+    /// what the mirrored clouds change in the sea behind (possibly
+    /// negative; the composite draws the bare sea). `None` while the size
+    /// is zero (nothing is drawn).
     pub fn cloud_layer(&self) -> Option<&wgpu::Texture> {
         (self.width > 0 && self.height > 0).then_some(&self.clouds.layer)
     }
