@@ -207,11 +207,14 @@ def read_vol(path):
     return np.frombuffer(raw[48:], "<f4").reshape(nz, ny, nx)
 
 
-def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False, sky=None):
+def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False, sky=None,
+                   ground=None):
     """Mitsuba's render of the exported volume: all orders of scattering
     of the sun and the sky's environment map, or (single) the sun's light
     scattered once; sky=False: the sun's light alone, all orders (what
-    surrogate.py --decompose splits the light by). Returns height x width x 3."""
+    surrogate.py --decompose splits the light by); ground=(r, g, b): a
+    Lambertian plane of that albedo at y = 0, three times the box wide
+    (ground_shadow.py). Returns height x width x 3."""
     import mitsuba as mi
 
     mi.set_variant("llvm_ad_rgb")
@@ -240,6 +243,14 @@ def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False, s
         # No sky under --single-scattering: the sun's light alone.
         **({"sky": {"type": "envmap", "filename": sky_path}}
            if (not single if sky is None else sky) else {}),
+        **({"ground": {
+            "type": "rectangle",
+            # The rectangle spans [-1, 1]² in z = 0, facing +z: turned to
+            # face +y, at y = 0 under the box's centre.
+            "to_world": T().translate([centre[0], 0.0, centre[2]]).rotate([1, 0, 0], -90)
+                           .scale([3 * half[0], 3 * half[2], 1]),
+            "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": list(ground)}},
+        }} if ground is not None else {}),
         "clouds": {
             "type": "cube",
             "to_world": T().translate(centre.tolist()).scale(half.tolist()),
