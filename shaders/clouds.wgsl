@@ -60,6 +60,9 @@ const MULTIPLE_SUN_POWER: f32 = 0.4;
 const DIFFUSE_GAIN: f32 = 0.45;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
 const AMBIENT_GAIN: f32 = 4.23;
+// The share of the sun's horizontal irradiance a whole sky of cloud sends
+// down onto the land (the CPU's sky.rs).
+const GROUND_CLOUD_LIGHT: f32 = 0.53;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
 // The sea's reflection: reflected rays a pixel, the uniform steps of each
@@ -81,7 +84,7 @@ struct Frame {
     screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
-    exposure: vec4f,     // exposure before the tone map, 1 when the cloud layer carries the sea's mirrored clouds (else 0), unused, unused
+    exposure: vec4f,     // exposure before the tone map, 1 when the cloud layer carries the sea's mirrored clouds (else 0), the share of the ground under cloud, unused
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
@@ -444,9 +447,19 @@ fn land_surface(sun_dir: vec3f, shadow: f32) -> vec3f {
 }
 
 // The flat land through the air, its sunlit part dimmed by the clouds'
-// shadow (the CPU's `land_radiance`).
+// shadow, with the sunlight the clouds scatter down onto it (the CPU's
+// `land_radiance`).
 fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
-    return ground_haze(land_surface(sun_dir, shadow), dir, sun_dir);
+    let surface = land_surface(sun_dir, shadow) + vec3f(0.08, 0.1, 0.06) * ground_cloud_light(sun_dir);
+    return ground_haze(surface, dir, sun_dir);
+}
+
+// The sunlight the clouds scatter down onto the land, its irradiance over
+// π per unit albedo, for the share frame.exposure.z of the ground under
+// cloud (the CPU's `ground_cloud_light`).
+fn ground_cloud_light(sun_dir: vec3f) -> vec3f {
+    let cover = clamp(frame.exposure.z, 0.0, 1.0);
+    return sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir) * (GROUND_CLOUD_LIGHT * cover * max(sun_dir.y, 0.0) / PI);
 }
 
 fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {

@@ -46,7 +46,7 @@ fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
         shadow = cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);
     }
     let sun = sun_light_at(p.y, sun_dir);
-    let sky = sky_ambient(sun_dir);
+    let sky = sky_ambient(sun_dir) + ground_cloud_light(sun_dir);
     let lit = albedo * (sun * (max(dot(n, sun_dir), 0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
     let a = aerial(dir, t, sun_dir);
     return lit * a.transmittance + a.inscatter;

@@ -232,6 +232,7 @@ impl Prepared {
             quality,
             terrain: self.terrain.as_ref(),
             sky,
+            cloud_cover: self.field.covered_fraction() as f32,
         }
     }
 

@@ -129,6 +129,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ),
         ("LIMB_DARKENING_U", sky_luts::LIMB_DARKENING_U as f64),
         ("REFLECTION_RAYS", renderer::REFLECTION_RAYS as f64),
+        ("GROUND_CLOUD_LIGHT", sky::GROUND_CLOUD_LIGHT as f64),
         ("REFLECTION_STEPS", renderer::REFLECTION_STEPS as f64),
         (
             "REFLECTION_MIN_ELEVATION",

@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::io::write_atomically;
 use crate::render::cpu::density::density_at;
 use crate::render::cpu::renderer::{ALBEDO, Frame};
-use crate::render::cpu::sky::{sea_radiance, sky_radiance, sun_direction, sun_light_at};
+use crate::render::cpu::sky::{SkyLight, sea_radiance, sky_radiance, sun_direction, sun_light_at};
 
 /// The largest number of cells along one axis.
 pub const MAX_CELLS: u32 = 2048;
@@ -279,10 +279,17 @@ pub fn envmap_direction(i: u32, j: u32, width: u32, height: u32) -> Vec3 {
 /// `sea_radiance`; no sun disk, which an offline renderer gets as a
 /// directional light) as a `width x height`
 /// latitude-longitude map of linear RGB, row-major, laid out for
-/// Mitsuba 3's `envmap` ([`envmap_direction`]).
+/// Mitsuba 3's `envmap` ([`envmap_direction`]). The land in it is the
+/// clear sky's, without the light the clouds scatter down onto it
+/// (`ground_cloud_light`): an offline renderer's clouds and ground plane
+/// make that light themselves, and the renderer's own clouds take the
+/// clear sky's land as their light from below (`ground_up`).
 pub fn sky_envmap(frame: &Frame, width: u32, height: u32) -> Vec<f32> {
     let sun = sun_direction(frame.sun_elevation_deg, frame.sun_azimuth_deg);
-    let sky = &frame.sky_light();
+    let sky = &SkyLight {
+        ground_cloud_light: Vec3::ZERO,
+        ..frame.sky_light()
+    };
     (0..height)
         .flat_map(|j| (0..width).map(move |i| (i, j)))
         .flat_map(|(i, j)| {

@@ -10,7 +10,7 @@ use std::f32::consts::PI;
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
 use super::sky::{
-    AtmosphereConfig, SkyLight, aerial, background_radiance, fresnel_water,
+    AtmosphereConfig, SkyLight, aerial, background_radiance, fresnel_water, ground_cloud_light,
     ground_haze_transmittance, ground_up, mirrored_sky, sky_ambient, sun_direction, sun_light_at,
 };
 use super::sky_luts::SkyLuts;
@@ -70,18 +70,28 @@ pub struct Frame<'a> {
     /// The physical sky's tables for this frame's sun and camera altitude
     /// (`quality.atmosphere.sky_params()`; none: the analytic sky).
     pub sky: Option<&'a SkyLuts>,
+    /// The share of the ground under cloud, 0..1 (P's covered fraction,
+    /// [`crate::sim::ProjectedField::covered_fraction`]): how much
+    /// sunlight the clouds scatter down onto the land
+    /// ([`super::sky::ground_cloud_light`]).
+    pub cloud_cover: f32,
 }
 
 impl Frame<'_> {
     /// What the sky functions read of this frame
     /// ([`super::sky::SkyLight`]).
     pub fn sky_light(&self) -> SkyLight<'_> {
-        SkyLight {
+        let mut sky = SkyLight {
             luts: self.sky,
             aerial_perspective: self.quality.atmosphere.aerial_perspective,
             haze_distance_m: self.quality.haze_distance_m,
             camera_altitude_m: self.view.eye().y,
-        }
+            ground_cloud_light: Vec3::ZERO,
+        };
+        let sun_dir = sun_direction(self.sun_elevation_deg, self.sun_azimuth_deg);
+        let middle = 0.5 * (self.density.band_bottom_m + self.density.band_top_m);
+        sky.ground_cloud_light = ground_cloud_light(&sky, sun_dir, self.cloud_cover, middle);
+        sky
     }
 }
 
@@ -290,7 +300,7 @@ pub fn terrain_radiance(
     };
     let light = &fr.sky_light();
     let sun = sun_light_at(light, p.y, sun_dir);
-    let sky = sky_ambient(light, sun_dir);
+    let sky = sky_ambient(light, sun_dir) + light.ground_cloud_light;
     let lit = albedo * (sun * (n.dot(sun_dir).max(0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
     let (inscatter, haze) = aerial(light, dir, t, sun_dir);
     lit * haze + inscatter

@@ -105,6 +105,10 @@ pub struct SkyLight<'a> {
     /// The camera's altitude, m (where the physical model's aerial
     /// perspective starts).
     pub camera_altitude_m: f32,
+    /// The sunlight the clouds scatter down onto the land the camera sees,
+    /// as the land's irradiance over π ([`ground_cloud_light`]; zero: the
+    /// clear sky's land).
+    pub ground_cloud_light: Vec3,
 }
 
 impl SkyLight<'static> {
@@ -115,6 +119,7 @@ impl SkyLight<'static> {
             aerial_perspective: true,
             haze_distance_m,
             camera_altitude_m: 0.0,
+            ground_cloud_light: Vec3::ZERO,
         }
     }
 }
@@ -268,11 +273,35 @@ pub fn land_surface(sky: &SkyLight, sun_dir: Vec3, shadow: f32) -> Vec3 {
     LAND_ALBEDO * lit
 }
 
-/// The flat land seen along `dir` (pointing down): [`land_surface`]
-/// through the air ([`ground_haze`]).
+/// The flat land seen along `dir` (pointing down): [`land_surface`] and
+/// the clouds' light on it (`sky.ground_cloud_light`) through the air
+/// ([`ground_haze`]).
 #[inline]
 pub fn land_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, shadow: f32) -> Vec3 {
-    ground_haze(sky, land_surface(sky, sun_dir, shadow), dir, sun_dir)
+    let surface = land_surface(sky, sun_dir, shadow) + LAND_ALBEDO * sky.ground_cloud_light;
+    ground_haze(sky, surface, dir, sun_dir)
+}
+
+/// The share of the sun's horizontal irradiance at the cloud band that a
+/// cloud layer covering the whole sky would send down onto the land as
+/// diffuse light ([`ground_cloud_light`]). Fitted to Mitsuba's path
+/// tracer over a Lambertian plane under the fair-weather clouds (P 34 %
+/// covered), which put 0.55 and 0.51 (suns 60° and 30° high) there
+/// beyond the clear sky's light (docs/ground_truth, "the land under the
+/// clouds").
+pub const GROUND_CLOUD_LIGHT: f32 = 0.53;
+
+/// The sunlight the clouds scatter down onto the land, as its irradiance
+/// over π, per unit albedo: [`GROUND_CLOUD_LIGHT`] times the share
+/// `cover` of the ground under cloud (P's covered fraction) times the
+/// sun's horizontal irradiance at the band's middle height
+/// `band_middle_m`, over π. The land in the clouds' shade gets the sky's
+/// light and this, which is the sun's colour, nearly white: without it
+/// the shade had half the path tracer's light and its blue.
+#[inline]
+pub fn ground_cloud_light(sky: &SkyLight, sun_dir: Vec3, cover: f32, band_middle_m: f32) -> Vec3 {
+    sun_light_at(sky, band_middle_m, sun_dir)
+        * (GROUND_CLOUD_LIGHT * cover.clamp(0.0, 1.0) * sun_dir.y.max(0.0) / PI)
 }
 
 /// The sun disk's radiance along `dir` (0 off the disk): analytic, a flat

@@ -87,6 +87,7 @@ mod physical {
             aerial_perspective: true,
             haze_distance_m: 25_000.0,
             camera_altitude_m: luts.camera_altitude_m,
+            ground_cloud_light: Vec3::ZERO,
         }
     }
 

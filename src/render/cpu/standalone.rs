@@ -12,10 +12,12 @@ use super::renderer::Frame;
 use super::sky::{SkyLight, aerial, background_radiance, sun_direction};
 use crate::render::sampling::frame_offset;
 
-/// The sky a stand-alone pass draws under: the frame's, analytic.
+/// The sky a stand-alone pass draws under: the frame's, analytic, over
+/// the clear sky's land (its GPU twin's uniforms carry no cloud cover).
 pub fn analytic<'a>(fr: &'a Frame) -> SkyLight<'a> {
     SkyLight {
         luts: None,
+        ground_cloud_light: glam::Vec3::ZERO,
         ..fr.sky_light()
     }
 }

@@ -608,6 +608,10 @@ impl CloudRenderer {
             mask: self.inputs.mask_info,
             map_size: self.inputs.map_size,
             sea_in_layer,
+            cloud_cover: self
+                .field
+                .as_ref()
+                .map_or(0.0, |f| f.covered_fraction() as f32),
         });
         self.queue
             .write_buffer(&self.inputs.uniforms, 0, bytemuck::bytes_of(&u));

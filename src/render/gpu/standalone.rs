@@ -119,6 +119,7 @@ impl StandalonePass {
             mask: [1, 1, 1, 0],
             map_size: 1,
             sea_in_layer: false,
+            cloud_cover: 0.0,
         });
         self.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));

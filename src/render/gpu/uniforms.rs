@@ -68,6 +68,9 @@ pub struct FrameInputs {
     /// for the composite's sea ([`crate::render::gpu::CloudRenderer::render`]);
     /// not in an engine's clouds-only layer, drawn over its own ground.
     pub sea_in_layer: bool,
+    /// The share of the ground under cloud (P's covered fraction): the
+    /// sunlight the clouds scatter down onto the land.
+    pub cloud_cover: f32,
 }
 
 impl FrameUniforms {
@@ -90,7 +93,12 @@ impl FrameUniforms {
             ],
             sun_dir: v4(sun_dir, q.haze_distance_m),
             sun_light: v4(sun, q.max_distance_m),
-            exposure: [q.exposure, if i.sea_in_layer { 1.0 } else { 0.0 }, 0.0, 0.0],
+            exposure: [
+                q.exposure,
+                if i.sea_in_layer { 1.0 } else { 0.0 },
+                i.cloud_cover,
+                0.0,
+            ],
             band: [
                 d.band_bottom_m,
                 d.band_top_m,
