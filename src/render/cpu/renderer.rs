@@ -278,8 +278,9 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
 }
 
 /// Radiance of the terrain at `p` (distance `t` along `dir`): lit by the
-/// sun through the clouds (their shadow, when shadows are on) and the sky,
-/// faded by aerial perspective.
+/// sun through the clouds (their shadow, when shadows are on), the sky
+/// and the sunlight the clouds scatter down (`ground_cloud_light`), faded
+/// by aerial perspective.
 pub fn terrain_radiance(
     p: Vec3,
     t: f32,

@@ -135,6 +135,9 @@ pub struct CloudRenderer {
     /// The last P given to [`Self::update_field`], as projected (spread
     /// again when the map extent changes).
     field: Option<ProjectedField>,
+    /// That P's covered fraction (the land's light from the clouds,
+    /// `Frame.exposure.z`), counted once per update, not per frame.
+    cloud_cover: f32,
     frame_index: u32,
     timestamps: Option<wgpu::QuerySet>,
     last_passes: Vec<&'static str>,
@@ -179,6 +182,7 @@ impl CloudRenderer {
             height: size.1,
             prev_view: None,
             field: None,
+            cloud_cover: 0.0,
             prev_view_proj: Mat4::IDENTITY,
             frame_index: 0,
             timestamps: None,
@@ -192,6 +196,7 @@ impl CloudRenderer {
     pub fn update_field(&mut self, queue: &wgpu::Queue, field: &ProjectedField) {
         let soft = soft_field(field, SPREAD_M, self.settings.density.map_extent_m);
         self.inputs.update_field(&self.device, queue, &soft);
+        self.cloud_cover = field.covered_fraction() as f32;
         self.field = Some(field.clone());
     }
 
@@ -608,10 +613,7 @@ impl CloudRenderer {
             mask: self.inputs.mask_info,
             map_size: self.inputs.map_size,
             sea_in_layer,
-            cloud_cover: self
-                .field
-                .as_ref()
-                .map_or(0.0, |f| f.covered_fraction() as f32),
+            cloud_cover: self.cloud_cover,
         });
         self.queue
             .write_buffer(&self.inputs.uniforms, 0, bytemuck::bytes_of(&u));
