@@ -10,8 +10,9 @@ use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::View;
 use cumulus::render::cpu::renderer::{
-    flat_ground_shadow, pixel_dither, render_clouds_linear, sea_reflection, to_srgb8,
+    flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
 };
+use cumulus::render::cpu::sea::sea_reflection;
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};
 use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, textures};

@@ -9,8 +9,11 @@ use cumulus::render::cpu::lighting::{
     SHADOW_STEP_SPAN_M, phase_dual, shadow_ray_length, sun_optical_depth, sun_transmittance,
 };
 use cumulus::render::cpu::renderer::{
-    ALBEDO, Frame, Quality, REFLECTION_MIN_ELEVATION, ReflectionLight, flat_ground_shadow,
-    march_ray, reflected_clouds, reflected_elevation, render_linear, sea_reflection, to_srgb8,
+    ALBEDO, Frame, Quality, flat_ground_shadow, march_ray, render_linear, to_srgb8,
+};
+use cumulus::render::cpu::sea::{
+    REFLECTION_MIN_ELEVATION, ReflectionLight, reflected_clouds, reflected_elevation,
+    sea_reflection,
 };
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, SkyModel, background_radiance, sun_direction, sun_light_at,

@@ -12,7 +12,7 @@ use std::mem::offset_of;
 use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
-use cumulus::render::cpu::{density, lighting, renderer, sky, sky_luts};
+use cumulus::render::cpu::{density, lighting, renderer, sea, sky, sky_luts};
 use cumulus::render::gpu::shaders::all_variants;
 use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
 
@@ -128,17 +128,17 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             sky_luts::AERIAL_PERSPECTIVE_STEPS as f64,
         ),
         ("LIMB_DARKENING_U", sky_luts::LIMB_DARKENING_U as f64),
-        ("REFLECTION_RAYS", renderer::REFLECTION_RAYS as f64),
+        ("REFLECTION_RAYS", sea::REFLECTION_RAYS as f64),
         ("GROUND_CLOUD_LIGHT", sky::GROUND_CLOUD_LIGHT as f64),
-        ("REFLECTION_STEPS", renderer::REFLECTION_STEPS as f64),
+        ("REFLECTION_STEPS", sea::REFLECTION_STEPS as f64),
         (
             "REFLECTION_MIN_ELEVATION",
-            renderer::REFLECTION_MIN_ELEVATION as f64,
+            sea::REFLECTION_MIN_ELEVATION as f64,
         ),
         ("GOLDEN", cumulus::render::sampling::GOLDEN as f64),
         (
             "REFLECTION_SHADOW_STEPS",
-            renderer::REFLECTION_SHADOW_STEPS as f64,
+            sea::REFLECTION_SHADOW_STEPS as f64,
         ),
         ("SKY_AMBIENT_ROWS", sky_luts::SKY_AMBIENT_SAMPLES.0 as f64),
         (

@@ -10,6 +10,7 @@
 pub mod density;
 pub mod lighting;
 pub mod renderer;
+pub mod sea;
 pub mod sky;
 pub mod sky_luts;
 pub mod spheroids;

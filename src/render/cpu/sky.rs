@@ -414,7 +414,7 @@ pub fn mirrored_sky(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
 /// clouds' `shadow` (transmittance toward the sun) dims the glint and the
 /// sunlit part of the water. `reflection` is the clouds the waves
 /// mirror (their premultiplied light and transmittance,
-/// `renderer::sea_reflection`; `(0, 1)`: none), in front of the mirrored
+/// `sea::sea_reflection`; `(0, 1)`: none), in front of the mirrored
 /// sky.
 #[inline]
 pub fn sea_radiance(

@@ -1,0 +1,235 @@
+//! The sea's mirror image of the clouds: the reflected rays a
+//! wind-roughened sea sends up (`reflected_elevation`), each one's coarse
+//! march through the band (`reflected_clouds`), their mean per sea pixel
+//! (`sea_reflection`) and what it changes in the pixel
+//! (`sea_reflection_change`, which the GPU's cloud pass adds to its
+//! layer). Twins of the WGSL functions of the same names in
+//! `shaders/clouds.wgsl`.
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use super::density::{band_segment, density_at};
+use super::lighting::{integrate_step, sun_scattering};
+#[cfg(doc)]
+use super::renderer::march_ray;
+use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, cloud_shadow};
+use super::sky::{
+    fresnel_water, ground_haze_transmittance, ground_up, mirrored_sky, sky_ambient, sun_light_at,
+};
+use crate::render::sampling::GOLDEN;
+
+/// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
+/// per stratum of the waves' slopes ([`reflected_elevation`]).
+pub const REFLECTION_RAYS: u32 = 6;
+/// Uniform steps of the march of each reflected ray
+/// (`REFLECTION_STEPS` in WGSL).
+pub const REFLECTION_STEPS: u32 = 4;
+/// Samples of each of its steps' shadow rays (`REFLECTION_SHADOW_STEPS`).
+pub const REFLECTION_SHADOW_STEPS: u32 = 2;
+/// The lowest elevation (radians, about 0.6°) a wave sends a reflected
+/// ray to; the facets that would send it lower are hidden behind the
+/// next wave at the grazing angles where that happens.
+pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
+
+/// The elevation (radians) of a ray the wind-roughened sea reflects,
+/// where the flat sea's mirror ray rises at `mirror` radians, at the
+/// quantile `u` in `(0, 1)` of the waves' slopes.
+///
+/// A facet tilted by a slope `s` toward or away from the viewer turns
+/// the reflected ray up or down by `2 s` (sideways tilts turn it in
+/// azimuth, by far less at the grazing angles where a sea's reflection
+/// shows). Cox and Munk's (1954) mean square slope `0.003 + 0.00512 U`
+/// for a wind of `U` m/s is split between the two directions, so the
+/// elevation spreads with a standard deviation of `√(2 · that)`: 0.28 rad
+/// (16°) at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
+/// distribution of that deviation (its quantile in closed form; its
+/// cumulative distribution within 0.02 of a Gaussian's), cut off below
+/// [`REFLECTION_MIN_ELEVATION`]: the waves draw a mirrored cloud out
+/// into a vertical smear, near the horizon only upward.
+#[inline]
+pub fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
+    let deviation = (2.0 * (0.003 + 0.00512 * wind_mps.max(0.0))).sqrt();
+    // A logistic of scale s has the deviation s·π/√3.
+    let s = deviation * 3f32.sqrt() / PI;
+    let lowest = 1.0 / (1.0 + ((mirror - REFLECTION_MIN_ELEVATION) / s).exp());
+    let q = (lowest + (1.0 - lowest) * u).clamp(1e-6, 1.0 - 1e-6);
+    mirror + s * (q / (1.0 - q)).ln()
+}
+
+/// The clouds mirrored by the sea where a ray that meets no terrain
+/// reaches it (y = 0; the flat mean surface, as the sky's reflection):
+/// (their light, premultiplied; the transmittance of the reflected rays
+/// through the band). The waves scatter the mirror image up and down
+/// ([`reflected_elevation`]), so the pixel averages [`REFLECTION_RAYS`]
+/// reflected rays, one in each stratum of the slopes' distribution (the
+/// strata shifted by the pixel's `dither`, so neighbouring pixels and
+/// TSAA frames fill in between them), each [`reflected_clouds`]. `(0, 1)`
+/// over land, with the camera under the ground, or when the sea lies
+/// beyond `max_distance_m`.
+pub fn sea_reflection(
+    origin: Vec3,
+    dir: Vec3,
+    dither: f32,
+    sun_dir: Vec3,
+    spread: f32,
+    fr: &Frame,
+) -> (Vec3, f32) {
+    let q = &fr.quality;
+    let Some(wind) = q.sea_wind_mps else {
+        return (Vec3::ZERO, 1.0);
+    };
+    if dir.y >= 0.0 || origin.y <= 0.0 {
+        return (Vec3::ZERO, 1.0);
+    }
+    let t_sea = origin.y / -dir.y;
+    if t_sea > q.max_distance_m {
+        return (Vec3::ZERO, 1.0);
+    }
+    let p = Vec3::new(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
+    let across = Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::Z);
+    let mirror = (-dir.y).clamp(-1.0, 1.0).asin();
+    // The steps' placement within a ray, apart from the strata's shift.
+    let step_dither = (dither + GOLDEN).fract();
+    let light_in = ReflectionLight::new(fr, sun_dir, wind);
+    let mut light = Vec3::ZERO;
+    let mut transmittance = 0.0;
+    for k in 0..REFLECTION_RAYS {
+        let u = (k as f32 + dither) / REFLECTION_RAYS as f32;
+        let e = reflected_elevation(mirror, wind, u);
+        let r = across * e.cos() + Vec3::Y * e.sin();
+        let (l, t) = reflected_clouds(p, r, t_sea, step_dither, sun_dir, &light_in, spread, fr);
+        light += l;
+        transmittance += t;
+    }
+    let n = REFLECTION_RAYS as f32;
+    (light / n, transmittance / n)
+}
+
+/// What lights the clouds a sea pixel mirrors, the same for each of its
+/// reflected rays (computed once in [`sea_reflection`]; arguments of
+/// `reflected_clouds` in WGSL): the sun at the band's middle, the
+/// sky's and the ground's ambient, and the waves' sideways blur (radians).
+#[derive(Debug, Clone, Copy)]
+pub struct ReflectionLight {
+    /// The sun's light at the band's middle.
+    pub sun: Vec3,
+    /// The upper sky's ambient ([`ambient_light`]'s `sky_top`).
+    pub sky_top: Vec3,
+    /// The sea's light from below ([`ambient_light`]'s `ground`).
+    pub ground: Vec3,
+    /// Twice the Cox-Munk slopes' deviation, radians: the level of
+    /// detail the mirrored clouds are read at, per metre of distance
+    /// (against aliasing; [`reflected_clouds`]).
+    pub blur: f32,
+}
+
+impl ReflectionLight {
+    /// The light of `fr` under a sun along `sun_dir`, over a sea in a
+    /// wind of `wind_mps`.
+    pub fn new(fr: &Frame, sun_dir: Vec3, wind_mps: f32) -> Self {
+        let sky = &fr.sky_light();
+        let d = &fr.density;
+        Self {
+            sun: sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir),
+            sky_top: sky_ambient(sky, sun_dir) * 0.25,
+            ground: ground_up(sky, sun_dir, true) * 0.25,
+            blur: 2.0 * (0.003 + 0.00512 * wind_mps.max(0.0)).sqrt(),
+        }
+    }
+}
+
+/// What the clouds the sea mirrors ([`sea_reflection`]) change in the
+/// radiance of a sea pixel along `dir`: [`super::sky::sea_radiance`] with them less
+/// without them, `(L - S (1 - T)) · F · T_air` for the clouds' light `L`
+/// and transmittance `T`, the mirrored sky `S` ([`mirrored_sky`]), the
+/// Fresnel factor `F` and the air's transmittance `T_air`
+/// ([`ground_haze_transmittance`]); zero where nothing is mirrored. The
+/// sky `S` the clouds hide is the flat mirror's, though the reflected
+/// rays that meet them rise higher: near the horizon, where the mirrored
+/// sky is brightest, the change is somewhat too dark.
+/// The GPU adds it to the cloud layer in the cloud pass (under the
+/// clouds' transmittance), so TSAA accumulates the reflection's grain
+/// with the clouds', and the composite draws the sea without it.
+pub fn sea_reflection_change(
+    origin: Vec3,
+    dir: Vec3,
+    dither: f32,
+    sun_dir: Vec3,
+    spread: f32,
+    fr: &Frame,
+) -> Vec3 {
+    let (light, transmittance) = sea_reflection(origin, dir, dither, sun_dir, spread, fr);
+    if transmittance >= 1.0 && light == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let sky = &fr.sky_light();
+    let f = fresnel_water((-dir.y).max(1e-3));
+    (light - mirrored_sky(sky, dir, sun_dir) * (1.0 - transmittance))
+        * f
+        * ground_haze_transmittance(sky, dir, sun_dir)
+}
+
+/// The clouds along one ray `r` the sea reflects from `p`, `t_sea` from
+/// the eye: (their light, premultiplied; the ray's transmittance through
+/// the band). The ray is marched across the band in
+/// [`REFLECTION_STEPS`] uniform steps, each sample placed in its step by
+/// `dither` (fine grain, not bands of rows that sample the same depths),
+/// each lit sample by the sun through [`cloud_shadow`] with
+/// [`REFLECTION_SHADOW_STEPS`] samples (the octaves as in the clouds' own
+/// light) and by the sky's and the ground's ambient (`light_in`): a coarser
+/// twin of [`march_ray`], for a reflection the Fresnel factor dims to a
+/// few percent looking down. The clouds are read at the level of detail
+/// of twice the Cox-Munk slopes' deviation times the distance
+/// (`light_in.blur`), so that 4 samples across the band do not alias.
+/// That blurs sideways too, more than the waves do at the grazing angles
+/// where reflections show (a sideways tilt `s` turns the ray by about
+/// `2 s tan(elevation)` in azimuth): a choice against aliasing, not the
+/// waves' own blur.
+#[allow(clippy::too_many_arguments)]
+pub fn reflected_clouds(
+    p: Vec3,
+    r: Vec3,
+    t_sea: f32,
+    dither: f32,
+    sun_dir: Vec3,
+    light_in: &ReflectionLight,
+    spread: f32,
+    fr: &Frame,
+) -> (Vec3, f32) {
+    let q = &fr.quality;
+    let d = &fr.density;
+    let Some((t0, t1)) = band_segment(p, r, d.band_bottom_m, d.band_top_m, q.max_distance_m) else {
+        return (Vec3::ZERO, 1.0);
+    };
+    let ReflectionLight {
+        sun,
+        sky_top,
+        ground,
+        blur,
+    } = *light_in;
+    let cos = r.dot(sun_dir);
+    let h = (t1 - t0) / REFLECTION_STEPS as f32;
+    let mut transmittance = 1.0_f32;
+    let mut light = Vec3::ZERO;
+    for i in 0..REFLECTION_STEPS {
+        let t = t0 + (i as f32 + dither) * h;
+        let x = p + r * t;
+        let sigma_t = density_at(x, &fr.fields, d, true, (spread + blur) * (t_sea + t));
+        if sigma_t <= 0.0 {
+            continue;
+        }
+        let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS, &fr.fields, d);
+        let tau_sun = -shadow.max(1e-30).ln();
+        let eta = ((x.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
+        let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves)
+            + ambient_light(sky_top, ground, eta);
+        light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
+        transmittance *= (-sigma_t * h).exp();
+        if transmittance < MIN_TRANSMITTANCE {
+            break;
+        }
+    }
+    (light, transmittance)
+}
