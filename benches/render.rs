@@ -1,11 +1,16 @@
-//! Cloud-map generation and CPU rendering of a 320x240 frame.
+//! Cloud-map generation, the light volume's build and its three steps,
+//! and CPU rendering of a 320x240 frame.
 //!
 //! `cargo bench --bench render`
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use cumulus::prepare::Prepared;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
+use cumulus::render::cpu::light_volume::{
+    DiffusionGrid, LIGHT_SWEEPS, LightVolume, cell_extinction, relax_sweeps, sun_depth,
+};
 use cumulus::render::cpu::renderer::render_linear;
+use cumulus::render::cpu::sky::sun_direction;
 use cumulus::scene::Scene;
 
 fn render(c: &mut Criterion) {
@@ -17,6 +22,22 @@ fn render(c: &mut Criterion) {
     let prepared = Prepared::from_scene(&scene, || {}).expect("prepares");
     let r = &scene.render;
     let frame = prepared.frame(r, r.quality());
+    let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
+    let grid = DiffusionGrid::new(&frame.density);
+    c.bench_function("light_volume_build_fair_weather", |b| {
+        b.iter(|| LightVolume::build(&frame.fields, &frame.density, sun))
+    });
+    c.bench_function("light_volume_cell_extinction", |b| {
+        b.iter(|| cell_extinction(&grid, &frame.fields, &frame.density))
+    });
+    let sigma = cell_extinction(&grid, &frame.fields, &frame.density);
+    c.bench_function("light_volume_sun_depth", |b| {
+        b.iter(|| sun_depth(&grid, &sigma, sun))
+    });
+    let tau = sun_depth(&grid, &sigma, sun);
+    c.bench_function("light_volume_relax_sweeps", |b| {
+        b.iter(|| relax_sweeps(&grid, &sigma, &tau, vec![0.0; grid.len()], LIGHT_SWEEPS))
+    });
     c.bench_function("cpu_render_320x240_fair_weather", |b| {
         b.iter(|| render_linear(320, 240, &frame))
     });

@@ -10,6 +10,7 @@ use glam::DVec2;
 
 use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::density::Fields;
+use crate::render::cpu::light_volume::LightVolume;
 use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::sky_luts::SkyLuts;
@@ -42,6 +43,10 @@ pub struct Prepared {
     /// that needs them (GPU-only runs never do), for that frame's sun and
     /// camera altitude; [`Self::clear_sky`] drops them.
     sky: OnceLock<Option<SkyLuts>>,
+    /// The CPU light volume, built by the first [`Self::frame`] with
+    /// multiple scattering on, for that frame's sun and density;
+    /// [`Self::clear_sky`] drops it too.
+    light: OnceLock<LightVolume>,
 }
 
 impl Prepared {
@@ -97,6 +102,7 @@ impl Prepared {
             band,
             map_extent_m: l,
             sky: OnceLock::new(),
+            light: OnceLock::new(),
         })
     }
 
@@ -140,16 +146,18 @@ impl Prepared {
             sim.project_into(&mut p.field, p.band);
             p.soft = soft_field(&p.field, SPREAD_M, p.map_extent_m as f32);
             p.parcels = sim.parcels().clone();
+            p.light = OnceLock::new();
             each(v, &p);
         }
         Ok(())
     }
 
-    /// Drops the physical sky's CPU tables, for a frame with another sun
-    /// or camera altitude than the first one's (the next [`Self::frame`]
-    /// builds them anew).
+    /// Drops the physical sky's CPU tables and the light volume, for a
+    /// frame with another sun, camera altitude or density settings than
+    /// the first one's (the next [`Self::frame`] builds them anew).
     pub fn clear_sky(&mut self) {
         self.sky = OnceLock::new();
+        self.light = OnceLock::new();
     }
 
     /// Physics frames simulated before the picture (exactly `time_s`: a
@@ -205,10 +213,23 @@ impl Prepared {
 
     /// The CPU frame for `settings` with `quality`. Under the physical sky
     /// (`quality.atmosphere`) the first call builds its tables for `r`'s
-    /// sun and camera altitude (about 0.1 s on two cores) and later calls
-    /// reuse them: call [`Self::clear_sky`] before a frame with another
-    /// sun elevation or camera altitude.
+    /// sun and camera altitude (about 0.1 s on two cores), and with
+    /// multiple scattering on the light volume for `r`'s sun and density
+    /// (about 0.5 s); later calls reuse them: call [`Self::clear_sky`]
+    /// before a frame with another sun, camera altitude or density
+    /// settings.
     pub fn frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
+        self.frame_with(r, quality, true)
+    }
+
+    /// [`Self::frame`] without the light volume, for what reads only the
+    /// density (a volume export, the field's statistics, the endless
+    /// volumes): nothing is lit, so nothing is built for the light.
+    pub fn density_frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
+        self.frame_with(r, quality, false)
+    }
+
+    fn frame_with<'a>(&'a self, r: &RenderSettings, quality: Quality, lit: bool) -> Frame<'a> {
         let sky = quality.atmosphere.sky_params().and_then(|params| {
             self.sky
                 .get_or_init(|| {
@@ -217,6 +238,17 @@ impl Prepared {
                 })
                 .as_ref()
         });
+        let fields = Fields {
+            p: &self.soft,
+            cloud_map: &self.cloud_map,
+        };
+        let density = r.density(self.band, self.map_extent_m);
+        let light = (lit && quality.octaves > 0 && !quality.single_scattering).then(|| {
+            self.light.get_or_init(|| {
+                let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
+                LightVolume::build(&fields, &density, sun)
+            })
+        });
         Frame {
             view: r.camera().view(
                 r.width as f32 / r.height.max(1) as f32,
@@ -224,15 +256,13 @@ impl Prepared {
             ),
             sun_elevation_deg: r.sun_elevation_deg,
             sun_azimuth_deg: r.sun_azimuth_deg,
-            fields: Fields {
-                p: &self.soft,
-                cloud_map: &self.cloud_map,
-            },
-            density: r.density(self.band, self.map_extent_m),
+            fields,
+            density,
             quality,
             terrain: self.terrain.as_ref(),
             sky,
             cloud_cover: self.field.covered_fraction() as f32,
+            light,
         }
     }
 

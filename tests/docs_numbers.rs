@@ -32,7 +32,11 @@ fn readme_statistics_table_matches_the_code() {
         let p = Prepared::from_scene(&sc, || {}).expect("prepare");
         let r = &sc.render;
         // `cumulus stats` defaults: 512 columns, 48 levels, tau 1, 4 cells.
-        let s = field_stats(&column_field(&p.frame(r, r.quality()), 512, 48), 1.0, 4);
+        let s = field_stats(
+            &column_field(&p.density_frame(r, r.quality()), 512, 48),
+            1.0,
+            4,
+        );
         let got = [
             s.cloud_fraction,
             s.dimension.expect("D"),

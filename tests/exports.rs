@@ -156,7 +156,7 @@ fn export_writes_the_density_the_renderer_marches() {
     let mut sc = Scene::load(&scene).expect("scene");
     sc.render.time_s = 900.0;
     let prepared = Prepared::from_scene(&sc, || {}).expect("prepare");
-    let frame = prepared.frame(&sc.render, sc.render.quality());
+    let frame = prepared.density_frame(&sc.render, sc.render.quality());
     let d = frame.density;
     let expected = Grid::cubic(
         64,

@@ -148,7 +148,11 @@ fn shipped_scenes_seen_from_above_are_natural_cumulus_fields_and_discs_are_not()
             .expect("shipped scene");
         let p = Prepared::from_scene(&sc, || {}).expect("prepare");
         let r = &sc.render;
-        let s = field_stats(&column_field(&p.frame(r, r.quality()), 512, 48), 1.0, 4);
+        let s = field_stats(
+            &column_field(&p.density_frame(r, r.quality()), 512, 48),
+            1.0,
+            4,
+        );
         eprintln!(
             "{name}: cloud fraction {:.3}, D {:?}, exponent {:?} over {:.1} decades",
             s.cloud_fraction,
@@ -207,7 +211,7 @@ fn shipped_scenes_do_not_repeat_at_the_domain_period() {
         let p = Prepared::from_scene(&sc, || {}).expect("prepare");
         let r = &sc.render;
         let l = sc.physics.domain_size_m;
-        let wide = column_field_over(&p.frame(r, r.quality()), -2.0 * l, 5.0 * l, 640, 24);
+        let wide = column_field_over(&p.density_frame(r, r.quality()), -2.0 * l, 5.0 * l, 640, 24);
         let rep = repetition(&wide.mask(1.0), 128);
         eprintln!(
             "{name}: {:.3} at the period, at most {:.3} elsewhere",

@@ -5,6 +5,7 @@ use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::density::{
     BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
 };
+use cumulus::render::cpu::light_volume::LightVolume;
 use cumulus::render::cpu::lighting::{
     SHADOW_STEP_SPAN_M, phase_dual, shadow_ray_length, sun_optical_depth, sun_transmittance,
 };
@@ -321,6 +322,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
         terrain: None,
         sky: None,
         cloud_cover: 0.0,
+        light: None,
     };
     let s = march_ray(origin, Vec3::Y, 0.5, 0.0, &frame);
     let expected = (-tau).exp() as f32;
@@ -386,6 +388,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
         terrain: None,
         sky: None,
         cloud_cover: 0.0,
+        light: None,
     }
 }
 
@@ -396,7 +399,11 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
     // map leaves almost none, and the pixels counted as sky were thin
     // cloud over it, which the diffused sunlight now whitens.)
     let p = ProjectedField::uniform(32, 32, [0.7, 0.8, 1.0]);
-    let fr = small_frame(&p, &cm);
+    let mut fr = small_frame(&p, &cm);
+    // Lit as a scene's frame is: with the light volume.
+    let sun = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let light = LightVolume::build(&fr.fields, &fr.density, sun);
+    fr.light = Some(&light);
     let img = render_linear(96, 64, &fr);
     assert!(img.iter().all(|c| c.is_finite()));
     // Of the pixels looking up: sky is bluer than red, cloud nearly grey.

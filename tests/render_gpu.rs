@@ -10,7 +10,9 @@ use cumulus::prepare::Prepared;
 use cumulus::render::cpu::lighting::{SHADOW_RAY_M, shadow_step_count};
 use cumulus::render::cpu::renderer::{render_converged, render_linear, to_srgb8};
 use cumulus::render::cpu::sky::SkyModel;
-use cumulus::render::gpu::renderer::{PASS_CLOUDS, PASS_COMPOSITE, PASS_TERRAIN, PASS_TSAA};
+use cumulus::render::gpu::renderer::{
+    PASS_CLOUDS, PASS_COMPOSITE, PASS_LIGHT_VOLUME, PASS_TERRAIN, PASS_TSAA,
+};
 use cumulus::render::gpu::sky_luts_pass::SkyTable;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuError, Headless, RenderError};
 use cumulus::scene::{RenderSettings, Scene};
@@ -205,9 +207,11 @@ fn each_scene_builds_only_the_passes_it_needs() {
         hl.renderer.last_passes(),
         [PASS_CLOUDS, PASS_TSAA, PASS_COMPOSITE]
     );
+    // The light volume's build ran too, submitted on its own before the
+    // frame (multiple scattering is on).
     assert_eq!(
         hl.renderer.pipelines(),
-        [PASS_CLOUDS, PASS_TSAA, PASS_COMPOSITE]
+        [PASS_LIGHT_VOLUME, PASS_CLOUDS, PASS_TSAA, PASS_COMPOSITE]
     );
     let t = hl.renderer.textures();
     assert!(
@@ -231,7 +235,7 @@ fn each_scene_builds_only_the_passes_it_needs() {
     );
     assert_eq!(
         hl.renderer.pipelines(),
-        [PASS_TERRAIN, PASS_CLOUDS, PASS_COMPOSITE]
+        [PASS_TERRAIN, PASS_LIGHT_VOLUME, PASS_CLOUDS, PASS_COMPOSITE]
     );
     let t = hl.renderer.textures();
     assert!(

@@ -12,7 +12,8 @@ use std::mem::offset_of;
 use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
-use cumulus::render::cpu::{density, lighting, renderer, sea, sky, sky_luts};
+use cumulus::render::cpu::{density, light_volume, lighting, renderer, sea, sky, sky_luts};
+use cumulus::render::gpu::light_volume_pass::{self, DiffusionGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
 use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
 
@@ -36,6 +37,16 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("sky_background", "background_radiance per pixel"),
     // Integer wrap of texel indices (rem_euclid on the CPU).
     ("wrap_i", "i64::rem_euclid on the CPU"),
+    // The light volume's grid: DiffusionGrid's methods index, cell, centre.
+    ("light_index", "DiffusionGrid::index"),
+    ("light_cell", "DiffusionGrid::cell"),
+    ("light_centre", "DiffusionGrid::centre"),
+    // Dispatch glue: the CPU iterates over DiffusionGrid::len() cells.
+    ("light_total", "DiffusionGrid::len"),
+    (
+        "light_invocation",
+        "a folded dispatch's cell (workgroups())",
+    ),
 ];
 
 /// Every WGSL constant and its Rust twin's value.
@@ -141,6 +152,17 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             sea::REFLECTION_SHADOW_STEPS as f64,
         ),
         ("SKY_AMBIENT_ROWS", sky_luts::SKY_AMBIENT_SAMPLES.0 as f64),
+        ("FLUENCE_GAIN", lighting::FLUENCE_GAIN as f64),
+        ("LIGHT_RELAXATION", light_volume::LIGHT_RELAXATION as f64),
+        ("PHASE_MEAN_COSINE", light_volume::PHASE_MEAN_COSINE as f64),
+        ("AIR_TRANSPORT_M", light_volume::AIR_TRANSPORT_M as f64),
+        (
+            "CLOUD_EXTINCTION_MIN",
+            light_volume::CLOUD_EXTINCTION_MIN as f64,
+        ),
+        ("LIGHT_SUN_MIN", light_volume::LIGHT_SUN_MIN as f64),
+        ("LIGHT_DEPTH_NONE", light_volume::LIGHT_DEPTH_NONE as f64),
+        ("LIGHT_WORKGROUP", light_volume_pass::LIGHT_WORKGROUP as f64),
         (
             "SKY_AMBIENT_COLUMNS",
             sky_luts::SKY_AMBIENT_SAMPLES.1 as f64,
@@ -277,6 +299,8 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
     use cumulus::render::cpu::volume::VolumeParams;
     let rust = offsets!(VolumeParams: origin, extent, dims, pick);
     same_layout("VolumeParams", &rust, size_of::<VolumeParams>());
+    let rust = offsets!(DiffusionGridUniforms: cells, cell_m);
+    same_layout("DiffusionGrid", &rust, size_of::<DiffusionGridUniforms>());
 }
 
 #[test]

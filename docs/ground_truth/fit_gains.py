@@ -28,10 +28,10 @@ from scipy.optimize import minimize
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import compare as C  # noqa: E402
-from surrogate import shipped_gains  # noqa: E402
+from surrogate import FIVE, shipped_gains  # noqa: E402
 
 Y = np.array([0.2126, 0.7152, 0.0722])
-PARTS = ["mf", "mi", "di", "am"]
+PARTS = ["mf", "mi", "di", "fl", "am"]
 
 
 def render(binary, name, width, height, ss, extra, tmp):
@@ -46,6 +46,21 @@ def render(binary, name, width, height, ss, extra, tmp):
     finally:
         os.remove(scene)
     return C.read_exr(exr).reshape(height, ss, width, ss, 3).mean(axis=(1, 3))
+
+
+def cached_render(a, binary, name, extra, tmp):
+    """`render`, read from `a.cache` when that binary (same size and
+    modification time) rendered the view with the same keys before."""
+    if not a.cache:
+        return render(binary, name, a.width, a.height, a.supersample, extra, tmp)
+    st = os.stat(binary)
+    keys = "_".join(f"{k}={v}" for k, v in sorted(extra.items()))
+    path = os.path.join(a.cache, f"{name}_{os.path.basename(binary)}_{st.st_size}_{int(st.st_mtime)}_"
+                                 f"{a.width}x{a.height}x{a.supersample}_{keys}.npy")
+    if not os.path.exists(path):
+        os.makedirs(a.cache, exist_ok=True)
+        np.save(path, render(binary, name, a.width, a.height, a.supersample, extra, tmp))
+    return np.load(path)
 
 
 def scores(data, g):
@@ -76,6 +91,11 @@ def main():
     ap.add_argument("--supersample", type=int, default=4)
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a [render] key for our renders (e.g. shadow_steps=32)")
+    ap.add_argument("--colour-weight", type=float, default=1.0,
+                    help="the weight of the colour term in the last fit (default 1)")
+    ap.add_argument("--cache", help="keep each render here, keyed by the binary's size and "
+                                    "time and the --set keys: a rebuilt part renders again, "
+                                    "the others are read back")
 
     a = ap.parse_args()
     extra = dict(kv.split("=", 1) for kv in a.set)
@@ -84,14 +104,14 @@ def main():
         for name in a.views.split(","):
             truth = np.load(os.path.join(a.arrays, f"{name}_mitsuba.npy"))
             cloud = np.load(os.path.join(a.arrays, f"{name}_cloud.npy"))
-            imgs = {v: render(os.path.join(a.bins, f"cumulus_{v}"), name, a.width, a.height,
-                              a.supersample, extra, tmp)[cloud] for v in ["zero"] + PARTS}
+            imgs = {v: cached_render(a, os.path.join(a.bins, f"cumulus_{v}"), name, extra, tmp)[cloud]
+                    for v in ["zero"] + PARTS}
             parts = np.stack([imgs[v] - imgs["zero"] for v in PARTS], -1)
             data[name] = (truth[cloud], imgs["zero"], parts)
             print(f"{name}: rendered", flush=True)
-    # MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, DIFFUSE_GAIN, AMBIENT_GAIN,
-    # as the Rust source has them.
-    shipped = np.array(shipped_gains())
+    # MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, DIFFUSE_GAIN, FLUENCE_GAIN,
+    # AMBIENT_GAIN, as the Rust source has them.
+    shipped = np.array(shipped_gains(FIVE))
     show("shipped", data, shipped)
     X = np.concatenate([np.einsum("nck,c->nk", p, Y) / (t @ Y)[:, None]
                         for t, z, p in data.values()])
@@ -99,12 +119,16 @@ def main():
     g_ls, *_ = np.linalg.lstsq(X, yv, rcond=None)
     show("least squares", data, g_ls)
     nm = {"maxiter": 4000, "xatol": 1e-4, "fatol": 1e-6}
-    fit = minimize(lambda g: sum(s[0] for s in scores(data, np.abs(g))), shipped,
+    # A gain shipped at 0 starts at 1: Nelder-Mead's first simplex around
+    # 0 is too small to leave it.
+    start = np.where(shipped == 0, 1.0, shipped)
+    fit = minimize(lambda g: sum(s[0] for s in scores(data, np.abs(g))), start,
                    method="Nelder-Mead", options=nm)
     show("per-pixel errors", data, np.abs(fit.x))
-    fit = minimize(lambda g: sum(s[0] + abs(np.log(s[3])) for s in scores(data, np.abs(g))),
-                   shipped, method="Nelder-Mead", options=nm)
-    show("per-pixel errors and colour", data, np.abs(fit.x))
+    w = a.colour_weight
+    fit = minimize(lambda g: sum(s[0] + w * abs(np.log(s[3])) for s in scores(data, np.abs(g))),
+                   start, method="Nelder-Mead", options=nm)
+    show(f"per-pixel errors and colour (weight {w})", data, np.abs(fit.x))
 
 
 if __name__ == "__main__":

@@ -233,17 +233,21 @@ def diffusion_fluence(vol, side, positions, down=2, air_mfp_m=200.0, cloud_sigma
     return map_coordinates(phi.reshape(nz, ny, nx), [q[:, 2], q[:, 1], q[:, 0]], order=1, mode="nearest")
 
 
-def shipped_gains():
-    """The gains the renderer ships with, read from its source: the
-    octaves' forward and isotropic gains, the diffused light's and the
-    ambient's."""
+FOUR = ("MULTIPLE_GAIN", "MULTIPLE_ISOTROPIC_GAIN", "DIFFUSE_GAIN", "AMBIENT_GAIN")
+FIVE = ("MULTIPLE_GAIN", "MULTIPLE_ISOTROPIC_GAIN", "DIFFUSE_GAIN", "FLUENCE_GAIN", "AMBIENT_GAIN")
+
+
+def shipped_gains(names=FOUR):
+    """The gains the renderer ships with, read from its source: by
+    default the octaves' forward and isotropic gains, the diffused
+    light's and the ambient's (`FIVE` adds the light volume's)."""
     import re
 
     consts = {}
     for f in ("src/render/cpu/lighting.rs", "src/render/cpu/renderer.rs"):
         for k, val in re.findall(r"pub const (\w+): f32 = ([0-9.]+);", open(os.path.join(C.ROOT, f)).read()):
             consts[k] = float(val)
-    return [consts[k] for k in ("MULTIPLE_GAIN", "MULTIPLE_ISOTROPIC_GAIN", "DIFFUSE_GAIN", "AMBIENT_GAIN")]
+    return [consts[k] for k in names]
 
 
 def fluence(s):

@@ -99,7 +99,7 @@ impl Database {
                         return;
                     }
                 };
-                let frame = p.frame(r, r.quality());
+                let frame = p.density_frame(r, r.quality());
                 let full = frame.density.extinction_per_m.max(1e-9);
                 let values = sample(&frame, &grid);
                 volumes.push(

@@ -71,7 +71,8 @@ pub struct RenderSettings {
     pub shadow_steps: u32,
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
     /// (the light was fitted to the path tracer with 3). 0 turns multiple
-    /// scattering off, the sunlight diffused through the layer with it.
+    /// scattering off, the sunlight diffused through the layer and the
+    /// light volume with it.
     pub octaves: u32,
     /// The analytic sky's aerial-perspective distance, m (> 0). Default
     /// 25000 (the physical sky's haze comes from its air,

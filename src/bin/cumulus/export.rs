@@ -100,7 +100,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
-    let frame = prepared.frame(r, r.quality());
+    let frame = prepared.density_frame(r, r.quality());
     guard_output_file(&a.out);
     guard_output_file(&sidecar_path);
     let values = volume_export::sample(&frame, &grid);

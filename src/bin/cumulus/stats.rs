@@ -68,7 +68,7 @@ pub fn run(a: StatsArgs) -> Result<()> {
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
     let r = &scene.render;
-    let frame = prepared.frame(r, r.quality());
+    let frame = prepared.density_frame(r, r.quality());
     let field = column_field(&frame, a.resolution, a.levels);
     let s = field_stats::field_stats(&field, a.tau_min, a.min_cells);
     let name = if scene.name.is_empty() {

@@ -141,18 +141,19 @@ pub const OCTAVE_EXTINCTION: f32 = 0.5;
 pub const OCTAVE_ECCENTRICITY: f32 = 0.8;
 /// The gain on the octaves' forward-scattered light (the phase
 /// function's lobes at the octave's eccentricity) at a sun in the zenith
-/// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`] and the
-/// ambient's gain are; docs/ground_truth).
-pub const MULTIPLE_GAIN: f32 = 0.5;
+/// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`],
+/// [`FLUENCE_GAIN`] and the ambient's gain are; docs/ground_truth).
+pub const MULTIPLE_GAIN: f32 = 0.63;
 /// The gain on the octaves' isotropic light: light scattered many times
-/// leaves a cloud in every direction, not only in the phase's lobes (a
-/// side view of a cloud is a quarter darker without it).
-pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.91;
+/// leaves a cloud in every direction, not only in the phase's lobes. It
+/// was 0.91 before the light volume, which now carries most of that
+/// light ([`FLUENCE_GAIN`]).
+pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.13;
 /// The octaves scale with the sun's height as `sin(elevation)^MULTIPLE_SUN_POWER`.
 pub const MULTIPLE_SUN_POWER: f32 = 0.4;
 /// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
 /// zenith.
-pub const DIFFUSE_GAIN: f32 = 0.45;
+pub const DIFFUSE_GAIN: f32 = 0.21;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
 /// cloud, not the thin haze and wisps between clouds, which have little
@@ -175,6 +176,21 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
     DIFFUSE_GAIN * mu_sun.max(0.0) * (1.0 - (-sigma_t * DIFFUSE_DEPTH_M).exp()) / (4.0 * PI)
 }
 
+/// The gain on the light volume's diffused sunlight
+/// ([`diffused_fluence`]; `FLUENCE_GAIN` in WGSL), fitted with the
+/// others: 1.06, where an exact diffusion would need 1 (the unscaled
+/// source, `e^{-τ}`, asked for 2.1).
+pub const FLUENCE_GAIN: f32 = 1.06;
+
+/// The sunlight diffused through the clouds, scattered toward the eye per
+/// unit scattering coefficient and per unit sun irradiance, from the
+/// light volume's fluence `phi` ([`super::light_volume::LightVolume`]):
+/// isotropic, `φ / 4π`, times [`FLUENCE_GAIN`].
+#[inline]
+pub fn diffused_fluence(phi: f32) -> f32 {
+    FLUENCE_GAIN * phi / (4.0 * PI)
+}
+
 /// Sun light scattered toward the eye per unit scattering coefficient in
 /// cloud of extinction `sigma_t`: single scattering (`phase_dual`
 /// through the optical depth `tau_sun`) and, when `octaves > 0`, multiple
@@ -186,8 +202,10 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
 /// power [`MULTIPLE_SUN_POWER`]; and the sunlight diffused through the
 /// layer ([`diffused_sun`]).
 ///
-/// The four gains (the octaves' two, the diffused light's and the
-/// ambient's [`super::renderer::AMBIENT_GAIN`]) were fitted to Mitsuba
+/// The light volume's term ([`diffused_fluence`]) is added beside this
+/// one (`renderer::diffused_light`). The five gains (the octaves' two,
+/// the two diffused lights' and the ambient's
+/// [`super::renderer::AMBIENT_GAIN`]) were fitted to Mitsuba
 /// 3's volumetric path tracer (all orders of scattering) on four views: a
 /// high sun, a low sun, a backlit view and a side view (docs/ground_truth:
 /// the model chosen with `surrogate.py`, the gains fitted on the

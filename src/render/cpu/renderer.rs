@@ -8,7 +8,8 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
-use super::lighting::{integrate_step, sun_optical_depth, sun_scattering};
+use super::light_volume::LightVolume;
+use super::lighting::{diffused_fluence, integrate_step, sun_optical_depth, sun_scattering};
 use super::sea::sea_reflection_change;
 use super::sky::{
     AtmosphereConfig, SkyLight, aerial, background_radiance, ground_cloud_light, ground_up,
@@ -76,6 +77,10 @@ pub struct Frame<'a> {
     /// sunlight the clouds scatter down onto the land
     /// ([`super::sky::ground_cloud_light`]).
     pub cloud_cover: f32,
+    /// The sunlight diffused through the clouds ([`LightVolume`], built
+    /// for this frame's field, density and sun; none: the term is left
+    /// out, as with no octaves).
+    pub light: Option<&'a LightVolume>,
 }
 
 impl Frame<'_> {
@@ -147,7 +152,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// bottom and 0.35 at the top ([`ambient_light`]), times this, which
 /// stands for that light's own multiple scattering; fitted with the
 /// octaves and the diffused sunlight ([`super::lighting::sun_scattering`]).
-pub const AMBIENT_GAIN: f32 = 4.23;
+pub const AMBIENT_GAIN: f32 = 4.42;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4` and the
@@ -247,7 +252,10 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             } else {
                 (ambient_light(sky_top, ground, eta), q.octaves)
             };
-            let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, octaves) + ambient;
+            let scatter = sun
+                * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, octaves)
+                    + diffused_light(p, octaves, fr))
+                + ambient;
             let s = scatter * (sigma_t * ALBEDO);
             let step_t = (-sigma_t * h).exp();
             light += integrate_step(s, sigma_t, h) * transmittance;
@@ -275,6 +283,18 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
         radiance: clouds + background * transmittance,
         clouds,
         transmittance,
+    }
+}
+
+/// The light volume's diffused sunlight at `p` per unit scattering
+/// coefficient and sun irradiance ([`diffused_fluence`] of the frame's
+/// [`LightVolume`]): 0 without one or without multiple scattering
+/// (`octaves` 0).
+#[inline]
+pub fn diffused_light(p: Vec3, octaves: u32, fr: &Frame) -> f32 {
+    match fr.light {
+        Some(v) if octaves > 0 => diffused_fluence(v.fluence_at(p, fr.density.map_extent_m)),
+        _ => 0.0,
     }
 }
 

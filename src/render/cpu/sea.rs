@@ -14,7 +14,9 @@ use super::density::{band_segment, density_at};
 use super::lighting::{integrate_step, sun_scattering};
 #[cfg(doc)]
 use super::renderer::march_ray;
-use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, cloud_shadow};
+use super::renderer::{
+    ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, cloud_shadow, diffused_light,
+};
 use super::sky::{
     fresnel_water, ground_haze_transmittance, ground_up, mirrored_sky, sky_ambient, sun_light_at,
 };
@@ -223,7 +225,9 @@ pub fn reflected_clouds(
         let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS, &fr.fields, d);
         let tau_sun = -shadow.max(1e-30).ln();
         let eta = ((x.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        let scatter = sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves)
+        let scatter = sun
+            * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves)
+                + diffused_light(x, q.octaves, fr))
             + ambient_light(sky_top, ground, eta);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= (-sigma_t * h).exp();

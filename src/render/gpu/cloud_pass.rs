@@ -1,7 +1,8 @@
 //! The `clouds` pass: full-screen, it marches the band segment of each
 //! ray, up to the depth (the terrain's or the application's) when there is
 //! one, into the cloud layer (premultiplied radiance, opacity) and, with
-//! TSAA, the cloud distance the reprojection needs.
+//! TSAA, the cloud distance the reprojection needs. With the light volume
+//! (multiple scattering on) it reads its fluence as bind group 2.
 
 use super::bind::{self, Recorder};
 use super::shaders;
@@ -12,8 +13,9 @@ pub const PASS_CLOUDS: &str = "clouds";
 
 /// The pipelines (built on first use) and the cloud layer.
 pub struct CloudPass {
-    /// Without and with a depth input.
-    pipelines: [Option<wgpu::RenderPipeline>; 2],
+    /// Without and with a depth input (`+ 1`), without and with the light
+    /// volume (`+ 2`).
+    pipelines: [Option<wgpu::RenderPipeline>; 4],
     depth_layout: wgpu::BindGroupLayout,
     no_depth_layout: wgpu::BindGroupLayout,
     no_depth: wgpu::BindGroup,
@@ -26,7 +28,7 @@ impl CloudPass {
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let no_depth_layout = bind::layout(device, "clouds.no_depth", &[]);
         Self {
-            pipelines: [None, None],
+            pipelines: [None, None, None, None],
             depth_layout: bind::layout(
                 device,
                 "clouds.depth",
@@ -45,7 +47,7 @@ impl CloudPass {
 
     /// Drops the pipelines (their constants or outputs changed).
     pub fn invalidate(&mut self) {
-        self.pipelines = [None, None];
+        self.pipelines = [None, None, None, None];
     }
 
     /// Pipelines built so far.
@@ -53,6 +55,7 @@ impl CloudPass {
         self.pipelines.iter().flatten().count()
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn pipeline(
         &mut self,
         device: &wgpu::Device,
@@ -61,29 +64,31 @@ impl CloudPass {
         depth: bool,
         tsaa: bool,
         physical: bool,
+        light: Option<&wgpu::BindGroupLayout>,
     ) -> &wgpu::RenderPipeline {
         let (depth_layout, no_depth_layout) = (&self.depth_layout, &self.no_depth_layout);
-        self.pipelines[depth as usize].get_or_insert_with(|| {
-            let module = bind::module(device, "clouds", shaders::cloud_pass(depth, tsaa, physical));
+        let slot = depth as usize + 2 * light.is_some() as usize;
+        self.pipelines[slot].get_or_insert_with(|| {
+            let source = shaders::cloud_pass(depth, tsaa, physical, light.is_some());
+            let module = bind::module(device, "clouds", source);
             let group1 = if depth { depth_layout } else { no_depth_layout };
+            let mut groups = vec![group0, group1];
+            groups.extend(light);
             let mut targets = vec![Some(CLOUD_FORMAT.into())];
             if tsaa {
                 targets.push(Some(DISTANCE_FORMAT.into()));
             }
             bind::full_screen_pipeline(
-                device,
-                "clouds",
-                &module,
-                &[group0, group1],
-                &targets,
-                None,
-                constants,
+                device, "clouds", &module, &groups, &targets, None, constants,
             )
         })
     }
 
     /// Records the pass: clouds in front of `depth` (when given) into the
-    /// layer, and the cloud distance into `distance` (TSAA only).
+    /// layer, and the cloud distance into `distance` (TSAA only), lit with
+    /// the light volume's fluence when `light` (its group 2 layout and
+    /// group) is given.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
         rec: &mut Recorder,
@@ -92,6 +97,7 @@ impl CloudPass {
         constants: &[(&str, f64)],
         depth: Option<&wgpu::TextureView>,
         distance: Option<&wgpu::TextureView>,
+        light: Option<(&wgpu::BindGroupLayout, &wgpu::BindGroup)>,
     ) -> wgpu::TextureView {
         let depth_group = depth.map(|d| {
             bind::bind(
@@ -110,6 +116,7 @@ impl CloudPass {
                 depth.is_some(),
                 distance.is_some(),
                 inputs.sky.is_some(),
+                light.map(|l| l.0),
             )
             .clone();
         let clear = Some(wgpu::Color::TRANSPARENT);
@@ -121,6 +128,9 @@ impl CloudPass {
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &inputs.group, &[]);
         pass.set_bind_group(1, depth_group.as_ref().unwrap_or(&self.no_depth), &[]);
+        if let Some((_, group)) = light {
+            pass.set_bind_group(2, group, &[]);
+        }
         pass.draw(0..3, 0..1);
         drop(pass);
         layer_view

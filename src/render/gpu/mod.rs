@@ -8,6 +8,7 @@ mod composite_pass;
 pub mod context;
 pub mod headless;
 mod inputs;
+pub mod light_volume_pass;
 pub mod renderer;
 pub mod settings;
 pub mod shaders;

@@ -10,13 +10,16 @@
 //! its own module:
 //! 1. `terrain` (scene has terrain, [`super::terrain_pass`]): the
 //!    heightfield mesh into an HDR colour target and a depth buffer.
-//! 2. `clouds` ([`super::cloud_pass`]): full-screen; marches the band
+//! 2. `light_volume` (multiple scattering on, [`super::light_volume_pass`]):
+//!    compute passes submitted before the frame's, only when P, the sun or
+//!    the density changed: the sunlight diffused through the clouds.
+//! 3. `clouds` ([`super::cloud_pass`]): full-screen; marches the band
 //!    segment of each ray up to the depth (terrain or an external depth
 //!    buffer) into the cloud layer (premultiplied radiance, opacity) and,
 //!    with TSAA, the cloud distance.
-//! 3. `tsaa` (TSAA on, [`super::tsaa`]): reprojects, clamps and blends the
+//! 4. `tsaa` (TSAA on, [`super::tsaa`]): reprojects, clamps and blends the
 //!    history (ping-pong pair).
-//! 4. `composite` ([`super::composite_pass`]): clouds over the sky or
+//! 5. `composite` ([`super::composite_pass`]): clouds over the sky or
 //!    terrain, tone-mapped into an 8-bit target (linear radiance into a
 //!    floating-point one).
 //!
@@ -30,6 +33,8 @@ pub use super::cloud_pass::PASS_CLOUDS;
 use super::composite_pass::CompositePass;
 pub use super::composite_pass::PASS_COMPOSITE;
 use super::inputs::Inputs;
+use super::light_volume_pass::LightVolumePass;
+pub use super::light_volume_pass::PASS_LIGHT_VOLUME;
 use super::settings::GpuSettings;
 use super::shaders::Background;
 use super::sky_luts_pass::{SkyTable, TableBuilds};
@@ -127,6 +132,8 @@ pub struct CloudRenderer {
     height: u32,
     inputs: Inputs,
     terrain: Option<TerrainPass>,
+    /// The sunlight diffused through the clouds (multiple scattering on).
+    light: Option<LightVolumePass>,
     clouds: CloudPass,
     tsaa: Option<TsaaPass>,
     composite: CompositePass,
@@ -168,6 +175,9 @@ impl CloudRenderer {
         let size = (0, 0);
         Self {
             terrain: terrain.map(|h| TerrainPass::new(device, queue, &inputs, &constants, h, size)),
+            light: settings
+                .light_volume()
+                .then(|| LightVolumePass::new(device, queue, &settings.density)),
             clouds: CloudPass::new(device, size.0, size.1),
             tsaa: settings
                 .tsaa
@@ -197,6 +207,9 @@ impl CloudRenderer {
         let soft = soft_field(field, SPREAD_M, self.settings.density.map_extent_m);
         self.inputs.update_field(&self.device, queue, &soft);
         self.cloud_cover = field.covered_fraction() as f32;
+        if let Some(l) = &mut self.light {
+            l.mark_stale();
+        }
         self.field = Some(field.clone());
     }
 
@@ -213,6 +226,9 @@ impl CloudRenderer {
     /// Replaces the cloud map.
     pub fn update_cloud_map(&mut self, queue: &wgpu::Queue, cloud_map: &CloudMap) {
         self.inputs.update_cloud_map(&self.device, queue, cloud_map);
+        if let Some(l) = &mut self.light {
+            l.mark_stale();
+        }
     }
 
     /// Changes the settings: pipelines whose constants changed are rebuilt
@@ -248,6 +264,7 @@ impl CloudRenderer {
         }
         self.inputs
             .set_detail(&self.device, &queue, settings.detail());
+        self.set_light(&old, constants_changed);
         if constants_changed && let Some(t) = &mut self.terrain {
             t.rebuild_pipeline(&self.device, &self.inputs, &constants);
         }
@@ -258,6 +275,42 @@ impl CloudRenderer {
             let queue = self.queue.clone();
             self.update_field(&queue, &f);
         }
+    }
+
+    /// Creates, drops or marks stale the light volume after a change of
+    /// settings from `old`.
+    fn set_light(&mut self, old: &GpuSettings, constants_changed: bool) {
+        let s = &self.settings;
+        if old.light_volume() != s.light_volume() {
+            self.clouds.invalidate();
+        }
+        let grid_changed = old.density.band_bottom_m != s.density.band_bottom_m
+            || old.density.band_top_m != s.density.band_top_m
+            || old.density.map_extent_m != s.density.map_extent_m;
+        if !s.light_volume() {
+            self.light = None;
+        } else if self.light.is_none() || grid_changed {
+            self.light = Some(LightVolumePass::new(&self.device, &self.queue, &s.density));
+        } else if let Some(l) = &mut self.light {
+            if constants_changed {
+                l.invalidate();
+            } else if old.density != s.density || old.sun_dir() != s.sun_dir() {
+                l.mark_stale();
+            }
+        }
+    }
+
+    /// The light volume (`None`: multiple scattering is off), for tests and
+    /// debug views.
+    pub fn light_volume(&self) -> Option<&LightVolumePass> {
+        self.light.as_ref()
+    }
+
+    /// How many times the light volume was built since the renderer was
+    /// made (`None`: multiple scattering is off, there is none): a still
+    /// field under a still sun builds it once.
+    pub fn light_volume_builds(&self) -> Option<u32> {
+        self.light.as_ref().map(|l| l.builds())
     }
 
     /// The settings in use.
@@ -327,6 +380,9 @@ impl CloudRenderer {
         let mut v = Vec::new();
         if self.terrain.is_some() {
             v.push(PASS_TERRAIN);
+        }
+        if self.light.as_ref().is_some_and(|l| l.has_pipelines()) {
+            v.push(PASS_LIGHT_VOLUME);
         }
         v.extend(std::iter::repeat_n(
             PASS_CLOUDS,
@@ -521,6 +577,16 @@ impl CloudRenderer {
         depth: Option<&wgpu::TextureView>,
     ) -> wgpu::TextureView {
         let distance = self.tsaa.as_ref().map(|t| bind::view(&t.distance));
+        if let Some(l) = &mut self.light {
+            l.build_if_stale(
+                &self.device,
+                &self.queue,
+                &self.inputs.layout,
+                &self.inputs.group,
+                constants,
+            );
+        }
+        let light = self.light.as_ref().map(|l| (&l.read_layout, &l.read_group));
         let layer = self.clouds.record(
             rec,
             &self.device,
@@ -528,6 +594,7 @@ impl CloudRenderer {
             constants,
             depth,
             distance.as_ref(),
+            light,
         );
         let resolved = match &mut self.tsaa {
             Some(t) => t.record(rec, &self.device, &self.inputs, &layer),

@@ -32,6 +32,12 @@ impl GpuSettings {
         self.density.detail_strength > 0.0
     }
 
+    /// Whether the light volume exists: with multiple scattering on
+    /// (`octaves > 0`), as on the CPU ([`crate::prepare::Prepared::frame`]).
+    pub fn light_volume(&self) -> bool {
+        self.quality.octaves > 0 && !self.quality.single_scattering
+    }
+
     /// The physical sky's atmosphere (`None`: the analytic sky).
     pub fn sky_params(&self) -> Option<SkyParams> {
         self.quality.atmosphere.sky_params()

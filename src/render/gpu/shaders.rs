@@ -25,10 +25,27 @@ pub const SKY_ANALYTIC: &str = include_str!("../../../shaders/sky_analytic.wgsl"
 /// [`SKY_LUTS`]).
 pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl");
 
+/// The light volume's grid, read and coefficients (after [`CLOUDS`]; each
+/// module that appends it declares `diffusion_grid` and `light_cells`).
+pub const LIGHT_VOLUME: &str = include_str!("../../../shaders/light_volume.wgsl");
+/// The light volume's compute entry points (after [`LIGHT_VOLUME`]).
+pub const LIGHT_VOLUME_BUILD: &str = include_str!("../../../shaders/light_volume_build.wgsl");
+
+/// `fluence_at` where there is no light volume: nothing diffused.
+const NO_LIGHT: &str = "fn fluence_at(p: vec3f) -> f32 {\n    return 0.0;\n}\n";
+
+/// The cloud pass's bindings of the light volume (group 2: the grid and
+/// the fluence) and its read.
+const LIGHT_READ: &str = "@group(2) @binding(0) var<uniform> diffusion_grid: DiffusionGrid;\n@group(2) @binding(1) var<storage, read> light_cells: array<f32>;\n\n// The fluence at p per unit sun irradiance, read where p reads P (the\n// CPU's `LightVolume::fluence_at`).\nfn fluence_at(p: vec3f) -> f32 {\n    return read_cells(noise_point(p, warped_lookup(p.x, p.z)));\n}\n";
+
 /// The shared functions with the sky model's: the physical atmosphere's
 /// tables (bindings 7 to 11 of group 0) when `physical`, else the
-/// analytic sky.
+/// analytic sky; no light volume.
 pub fn shared(physical: bool) -> String {
+    format!("{}{NO_LIGHT}", sky_model(physical))
+}
+
+fn sky_model(physical: bool) -> String {
     if physical {
         format!("{CLOUDS}\n{SKY_LUTS}\n{SKY_PHYSICAL}\n")
     } else {
@@ -38,9 +55,14 @@ pub fn shared(physical: bool) -> String {
 
 /// The cloud pass's source: marches to the depth buffer's surface when
 /// `depth`, and writes the cloud distance for the TSAA reprojection when
-/// `tsaa`, under the physical sky when `physical`.
-pub fn cloud_pass(depth: bool, tsaa: bool, physical: bool) -> String {
-    let mut s = shared(physical);
+/// `tsaa`, under the physical sky when `physical`, reading the light
+/// volume (group 2) when `light`.
+pub fn cloud_pass(depth: bool, tsaa: bool, physical: bool, light: bool) -> String {
+    let mut s = if light {
+        format!("{}{LIGHT_VOLUME}\n{LIGHT_READ}", sky_model(physical))
+    } else {
+        shared(physical)
+    };
     if depth {
         s.push_str("\n@group(1) @binding(0) var depth_tex: texture_depth_2d;\n");
     }
@@ -132,6 +154,15 @@ pub fn volume_pass() -> String {
     )
 }
 
+/// The light volume's build: its three compute entry points over group 0
+/// (the density) and group 1 (its buffers).
+pub fn light_volume_build() -> String {
+    format!(
+        "{}{NO_LIGHT}\n{LIGHT_VOLUME}\n{LIGHT_VOLUME_BUILD}",
+        sky_model(false)
+    )
+}
+
 /// The sky tables' source: three compute entry points.
 pub fn sky_luts_pass() -> String {
     format!("{SKY_LUTS}\n{SKY_LUTS_BUILD}")
@@ -146,12 +177,15 @@ pub fn all_variants() -> Vec<String> {
         spheroids_pass(),
         volume_pass(),
         sky_luts_pass(),
+        light_volume_build(),
     ];
     for physical in [false, true] {
         sources.push(terrain_pass(physical));
         for depth in [false, true] {
             for tsaa in [false, true] {
-                sources.push(cloud_pass(depth, tsaa, physical));
+                for light in [false, true] {
+                    sources.push(cloud_pass(depth, tsaa, physical, light));
+                }
             }
         }
         for b in [
