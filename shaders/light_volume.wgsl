@@ -1,9 +1,11 @@
 // The light volume's grid, its trilinear read and the diffusion's
 // coefficients: the twins of src/render/cpu/light_volume.rs (same names).
-// Appended after clouds.wgsl by the light volume's build (with
-// light_volume_build.wgsl) and by the cloud pass that reads it; each
-// declares `diffusion_grid` and `light_cells` (the extinction while building,
-// the fluence while rendering) itself.
+// Appended after clouds.wgsl by the light volume's build, before
+// light_volume_build.wgsl, which declares `diffusion_grid` and
+// `light_cells` (the cells' extinction). The cloud pass reads the
+// fluence from the texture the build writes last (`fluence_at` in
+// src/render/gpu/shaders.rs), filtered by the hardware as `read_cells`
+// filters on the CPU.
 
 const LIGHT_RELAXATION: f32 = 1.7;
 const PHASE_MEAN_COSINE: f32 = 0.525;

@@ -15,6 +15,8 @@
 @group(1) @binding(2) var<storage, read_write> light_cells: array<f32>;
 @group(1) @binding(3) var<storage, read_write> light_tau: array<f32>;
 @group(1) @binding(4) var<storage, read_write> light_phi: array<f32>;
+// The fluence as the cloud pass reads it (`fluence_at`, filtered).
+@group(1) @binding(5) var light_texture: texture_storage_3d<rgba16float, write>;
 
 const LIGHT_WORKGROUP: u32 = 64u;
 // The optical depth under a sun too low: exp(-x) of it is 0.
@@ -137,4 +139,15 @@ fn relax(@builtin(global_invocation_id) id: vec3u) {
     }
     let old = light_phi[idx];
     light_phi[idx] = old + LIGHT_RELAXATION * (sum / diagonal - old);
+}
+
+// The fluence into the texture the cloud pass samples: texel (i, j, k)
+// is cell (i, j, k).
+@compute @workgroup_size(64)
+fn fluence_texture(@builtin(global_invocation_id) id: vec3u) {
+    let idx = light_invocation(id);
+    if idx >= light_total() {
+        return;
+    }
+    textureStore(light_texture, light_cell(idx), vec4f(light_phi[idx], 0.0, 0.0, 1.0));
 }

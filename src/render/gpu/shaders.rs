@@ -34,9 +34,9 @@ pub const LIGHT_VOLUME_BUILD: &str = include_str!("../../../shaders/light_volume
 /// `fluence_at` where there is no light volume: nothing diffused.
 const NO_LIGHT: &str = "fn fluence_at(p: vec3f) -> f32 {\n    return 0.0;\n}\n";
 
-/// The cloud pass's bindings of the light volume (group 2: the grid and
-/// the fluence) and its read.
-const LIGHT_READ: &str = "@group(2) @binding(0) var<uniform> diffusion_grid: DiffusionGrid;\n@group(2) @binding(1) var<storage, read> light_cells: array<f32>;\n\n// The fluence at p per unit sun irradiance, read where p reads P (the\n// CPU's `LightVolume::fluence_at`).\nfn fluence_at(p: vec3f) -> f32 {\n    return read_cells(noise_point(p, warped_lookup(p.x, p.z)));\n}\n";
+/// The cloud pass's bindings of the light volume (group 2: the fluence
+/// texture and its sampler) and its read.
+const LIGHT_READ: &str = "@group(2) @binding(0) var light_fluence: texture_3d<f32>;\n@group(2) @binding(1) var light_sampler: sampler;\n\n// The fluence at p per unit sun irradiance, read where p reads P (the\n// CPU's `LightVolume::fluence_at`): the texel centres are the cells'.\nfn fluence_at(p: vec3f) -> f32 {\n    let q = noise_point(p, warped_lookup(p.x, p.z));\n    let uvw = vec3f(q.x / frame.map.x, (q.y - frame.band.x) / (frame.band.y - frame.band.x), q.z / frame.map.x);\n    return textureSampleLevel(light_fluence, light_sampler, uvw, 0.0).r;\n}\n";
 
 /// The shared functions with the sky model's: the physical atmosphere's
 /// tables (bindings 7 to 11 of group 0) when `physical`, else the
@@ -59,7 +59,7 @@ fn sky_model(physical: bool) -> String {
 /// volume (group 2) when `light`.
 pub fn cloud_pass(depth: bool, tsaa: bool, physical: bool, light: bool) -> String {
     let mut s = if light {
-        format!("{}{LIGHT_VOLUME}\n{LIGHT_READ}", sky_model(physical))
+        format!("{}{LIGHT_READ}", sky_model(physical))
     } else {
         shared(physical)
     };
