@@ -224,7 +224,8 @@ impl Prepared {
 
     /// [`Self::frame`] without the light volume, for what reads only the
     /// density (a volume export, the field's statistics, the endless
-    /// volumes): nothing is lit, so nothing is built for the light.
+    /// volumes) or lights itself (the spheroid and volume renderers'
+    /// CPU twins): nothing is built for the light.
     pub fn density_frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
         self.frame_with(r, quality, false)
     }

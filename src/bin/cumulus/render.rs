@@ -374,7 +374,9 @@ fn render_spheroids(
             )?;
         }
         None => {
-            let frame = prepared.frame(r, r.quality());
+            // The spheroids light themselves (their light grid): no light
+            // volume.
+            let frame = prepared.density_frame(r, r.quality());
             let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
             let grid = LightGrid::build(&spheroids, sun, frame.density.extinction_per_m);
             let linear = cpu_render(r.width, r.height, &frame, &spheroids, &grid);
@@ -461,7 +463,7 @@ fn render_endless(
         }
         None => {
             let p = Prepared::unsimulated(scene)?;
-            let frame = p.frame(r, r.quality());
+            let frame = p.density_frame(r, r.quality());
             let linear = render_volume(r.width, r.height, &frame, &params, &stack, r.cpu_offsets);
             write_linear(out, picture, r, &linear)?;
         }

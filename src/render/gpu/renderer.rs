@@ -291,6 +291,8 @@ impl CloudRenderer {
             self.light = None;
         } else if self.light.is_none() || grid_changed {
             self.light = Some(LightVolumePass::new(&self.device, &self.queue, &s.density));
+            // Group 2's layout is new.
+            self.clouds.invalidate();
         } else if let Some(l) = &mut self.light {
             if constants_changed {
                 l.invalidate();
