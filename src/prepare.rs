@@ -215,7 +215,7 @@ impl Prepared {
     /// (`quality.atmosphere`) the first call builds its tables for `r`'s
     /// sun and camera altitude (about 0.1 s on two cores), and with
     /// multiple scattering on the light volume for `r`'s sun and density
-    /// (about 0.5 s); later calls reuse them: call [`Self::clear_sky`]
+    /// (about 0.3 s); later calls reuse them: call [`Self::clear_sky`]
     /// before a frame with another sun, camera altitude or density
     /// settings.
     pub fn frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {

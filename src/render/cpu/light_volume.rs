@@ -126,20 +126,14 @@ impl DiffusionGrid {
 /// (`read_cells` in WGSL).
 #[inline]
 pub fn read_cells(values: &[f32], grid: &DiffusionGrid, p: Vec3) -> f32 {
-    let u = p.x / grid.cell_m.x - 0.5;
     let v = ((p.y - grid.bottom_m) / grid.cell_m.y - 0.5).clamp(0.0, grid.cells.y as f32 - 1.0);
-    let w = p.z / grid.cell_m.z - 0.5;
-    let (i, j, k) = (u.floor(), v.floor(), w.floor());
-    let (fx, fy, fz) = (u - i, v - j, w - k);
-    let (i, j, k) = (i as i32, j as i32, k as i32);
-    let j1 = (j + 1).min(grid.cells.y as i32 - 1);
-    let at = |a: i32, b: i32, c: i32| values[grid.index(a, b, c)];
-    let layer = |b: i32| {
-        let lo = at(i, b, k) + fx * (at(i + 1, b, k) - at(i, b, k));
-        let hi = at(i, b, k + 1) + fx * (at(i + 1, b, k + 1) - at(i, b, k + 1));
-        lo + fz * (hi - lo)
-    };
-    let (a, b) = (layer(j), layer(j1));
+    let j = v.floor();
+    let fy = v - j;
+    let j = j as usize;
+    let j1 = (j + 1).min(grid.cells.y as usize - 1);
+    let n = (grid.cells.x * grid.cells.z) as usize;
+    let a = read_layer(&values[j * n..(j + 1) * n], grid, p.x, p.z);
+    let b = read_layer(&values[j1 * n..(j1 + 1) * n], grid, p.x, p.z);
     a + fy * (b - a)
 }
 

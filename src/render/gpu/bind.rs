@@ -34,6 +34,16 @@ fn texture_of(
     )
 }
 
+/// A binding of the compute stage.
+pub fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
 /// A 2D texture binding.
 pub fn texture_entry(
     binding: u32,

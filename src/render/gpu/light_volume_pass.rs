@@ -11,7 +11,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use super::bind;
+use super::bind::{self, compute_entry};
 use super::context::{GpuContext, GpuError};
 use super::shaders;
 use crate::render::cpu::density::DensityParams;
@@ -95,15 +95,6 @@ fn storage(device: &wgpu::Device, label: &str, cells: usize) -> wgpu::Buffer {
             | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
-}
-
-fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty,
-        count: None,
-    }
 }
 
 fn buffer_type(ty: wgpu::BufferBindingType, dynamic: bool) -> wgpu::BindingType {

@@ -48,6 +48,7 @@ use super::uniforms::{FrameInputs, FrameUniforms};
 use super::{bind, bind::Recorder};
 use crate::render::camera::{ToView, View};
 use crate::render::cloud_map::CloudMap;
+use crate::render::cpu::light_volume::DiffusionGrid;
 use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
@@ -284,12 +285,10 @@ impl CloudRenderer {
         if old.light_volume() != s.light_volume() {
             self.clouds.invalidate();
         }
-        let grid_changed = old.density.band_bottom_m != s.density.band_bottom_m
-            || old.density.band_top_m != s.density.band_top_m
-            || old.density.map_extent_m != s.density.map_extent_m;
+        let grid = DiffusionGrid::new(&s.density);
         if !s.light_volume() {
             self.light = None;
-        } else if self.light.is_none() || grid_changed {
+        } else if self.light.as_ref().is_none_or(|l| l.grid != grid) {
             self.light = Some(LightVolumePass::new(&self.device, &self.queue, &s.density));
             // Group 2's layout is new.
             self.clouds.invalidate();

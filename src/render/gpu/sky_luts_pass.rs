@@ -10,7 +10,7 @@
 
 use glam::Vec3;
 
-use super::bind;
+use super::bind::{self, compute_entry};
 use super::context::{GpuContext, GpuError};
 use super::shaders::sky_luts_pass;
 use super::textures::create_2d;
@@ -124,15 +124,6 @@ pub struct SkyLutsPass {
     timestamps: Option<Timestamps>,
     last: Inputs,
     builds: TableBuilds,
-}
-
-fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty,
-        count: None,
-    }
 }
 
 fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
