@@ -3,15 +3,15 @@
 // Appended after clouds.wgsl by the light volume's build, before
 // light_volume_build.wgsl, which declares `diffusion_grid` and
 // `light_cells` (the cells' extinction). The cloud pass reads the
-// fluence from the texture the build writes last (`fluence_at` in
+// fluence and flux from the texture the build writes last (`light_at` in
 // src/render/gpu/shaders.rs), filtered by the hardware as `read_cells`
 // filters on the CPU.
 
 const LIGHT_RELAXATION: f32 = 1.7;
-const PHASE_MEAN_COSINE: f32 = 0.525;
 const AIR_TRANSPORT_M: f32 = 200.0;
 const CLOUD_EXTINCTION_MIN: f32 = 0.004;
 const LIGHT_SUN_MIN: f32 = 0.05;
+const FLUX_LIMIT: f32 = 0.63492066;
 
 // Mirrors `DiffusionGridUniforms` in src/render/gpu/light_volume_pass.rs.
 struct DiffusionGrid {

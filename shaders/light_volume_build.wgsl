@@ -15,7 +15,7 @@
 @group(1) @binding(2) var<storage, read_write> light_cells: array<f32>;
 @group(1) @binding(3) var<storage, read_write> light_tau: array<f32>;
 @group(1) @binding(4) var<storage, read_write> light_phi: array<f32>;
-// The fluence as the cloud pass reads it (`fluence_at`, filtered).
+// The fluence and flux as the cloud pass reads them (`light_at`, filtered).
 @group(1) @binding(5) var light_texture: texture_storage_3d<rgba16float, write>;
 
 const LIGHT_WORKGROUP: u32 = 64u;
@@ -141,13 +141,44 @@ fn relax(@builtin(global_invocation_id) id: vec3u) {
     light_phi[idx] = old + LIGHT_RELAXATION * (sum / diagonal - old);
 }
 
-// The fluence into the texture the cloud pass samples: texel (i, j, k)
-// is cell (i, j, k).
+// The net flux of the diffused light through cell `idx`: Fick's law by
+// central differences, one-sided at the band's floor and ceiling, at most
+// FLUX_LIMIT of the fluence (the CPU's `light_flux`).
+fn light_flux(idx: u32) -> vec3f {
+    let c = light_cell(idx);
+    let h = diffusion_grid.cell_m.xyz;
+    let ny = i32(diffusion_grid.cells.y);
+    let dx = (light_phi[light_index(c.x + 1, c.y, c.z)] - light_phi[light_index(c.x - 1, c.y, c.z)]) / (2.0 * h.x);
+    let dz = (light_phi[light_index(c.x, c.y, c.z + 1)] - light_phi[light_index(c.x, c.y, c.z - 1)]) / (2.0 * h.z);
+    var up = 0.0;
+    var span_up = 0.5 * h.y;
+    if c.y + 1 < ny {
+        up = light_phi[light_index(c.x, c.y + 1, c.z)];
+        span_up = h.y;
+    }
+    var down = 0.0;
+    var span_down = 0.5 * h.y;
+    if c.y > 0 {
+        down = light_phi[light_index(c.x, c.y - 1, c.z)];
+        span_down = h.y;
+    }
+    let dy = (up - down) / (span_up + span_down);
+    let f = -diffusion_coefficient(light_cells[idx]) * vec3f(dx, dy, dz);
+    let limit = FLUX_LIMIT * max(light_phi[idx], 0.0);
+    let size = length(f);
+    if size > limit {
+        return f * (limit / size);
+    }
+    return f;
+}
+
+// The fluence and the net flux into the texture the cloud pass samples:
+// texel (i, j, k) is cell (i, j, k).
 @compute @workgroup_size(64)
 fn fluence_texture(@builtin(global_invocation_id) id: vec3u) {
     let idx = light_invocation(id);
     if idx >= light_total() {
         return;
     }
-    textureStore(light_texture, light_cell(idx), vec4f(light_phi[idx], 0.0, 0.0, 1.0));
+    textureStore(light_texture, light_cell(idx), vec4f(light_phi[idx], light_flux(idx)));
 }

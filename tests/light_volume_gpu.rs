@@ -25,6 +25,10 @@ fn scene(name: &str) -> Scene {
 const FLUENCE_MEAN_REL: f64 = 0.01;
 const FLUENCE_HIGH_REL: f64 = 0.1;
 const FLUENCE_MAX_REL: f64 = 0.6;
+/// The net flux's difference over the cell's fluence: the mean and the
+/// 99.9th percentile.
+const FLUX_MEAN_REL: f64 = 0.01;
+const FLUX_HIGH_REL: f64 = 0.1;
 
 #[test]
 fn the_gpu_light_volume_is_its_cpu_twin() {
@@ -69,6 +73,49 @@ fn the_gpu_light_volume_is_its_cpu_twin() {
         assert!(mean < FLUENCE_MEAN_REL, "{name}: mean {mean}");
         assert!(high < FLUENCE_HIGH_REL, "{name}: 99.9th percentile {high}");
         assert!(worst < FLUENCE_MAX_REL, "{name}: largest {worst}");
+
+        // What the cloud pass samples: the fluence again (as half floats)
+        // and the net flux, against the CPU's over the same cells, the
+        // flux's difference relative to the cell's fluence (the flux is
+        // at most a third of it, and crosses zero).
+        let texels = pass.read_light(&ctx).expect("texture readback");
+        assert_eq!(texels.len(), cpu.fluence.len());
+        let (mut fluence_rel, mut flux_rel, mut flux_size) = (Vec::new(), Vec::new(), 0.0f64);
+        for ((t, c), f) in texels.iter().zip(&cpu.fluence).zip(&cpu.flux) {
+            if *c > 0.01 * peak {
+                fluence_rel.push(((t[0] - c).abs() / c) as f64);
+                let g = glam::Vec3::new(t[1], t[2], t[3]);
+                flux_rel.push(((g - *f).length() / c) as f64);
+                flux_size += (f.length() / c) as f64;
+            }
+        }
+        for v in [&mut fluence_rel, &mut flux_rel] {
+            v.sort_by(f64::total_cmp);
+        }
+        let n = flux_rel.len();
+        let texture_mean = fluence_rel.iter().sum::<f64>() / n as f64;
+        let flux_mean = flux_rel.iter().sum::<f64>() / n as f64;
+        let flux_high = flux_rel[n * 999 / 1000];
+        eprintln!(
+            "{name}: texture fluence mean {texture_mean:.2e}; flux over fluence: CPU's mean size {:.3}, difference mean {flux_mean:.2e}, 99.9th percentile {flux_high:.2e}",
+            flux_size / n as f64
+        );
+        assert!(
+            texture_mean < FLUENCE_MEAN_REL,
+            "{name}: texture {texture_mean}"
+        );
+        // The flux is there (a cloud's light flows outward), and the GPU's
+        // is the CPU's.
+        assert!(
+            flux_size / n as f64 > 0.05,
+            "{name}: flux {}",
+            flux_size / n as f64
+        );
+        assert!(flux_mean < FLUX_MEAN_REL, "{name}: flux mean {flux_mean}");
+        assert!(
+            flux_high < FLUX_HIGH_REL,
+            "{name}: flux 99.9th percentile {flux_high}"
+        );
     }
 }
 

@@ -162,6 +162,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ),
         ("LIGHT_SUN_MIN", light_volume::LIGHT_SUN_MIN as f64),
         ("LIGHT_DEPTH_NONE", light_volume::LIGHT_DEPTH_NONE as f64),
+        ("FLUX_LIMIT", light_volume::FLUX_LIMIT as f64),
         ("LIGHT_WORKGROUP", light_volume_pass::LIGHT_WORKGROUP as f64),
         (
             "SKY_AMBIENT_COLUMNS",

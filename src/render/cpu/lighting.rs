@@ -7,6 +7,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::density::{DensityParams, Fields, density_at, height_fraction};
+use super::light_volume::PHASE_MEAN_COSINE;
 
 /// Henyey-Greenstein phase function, 1/sr; integrates to 1 over the sphere.
 #[inline]
@@ -148,12 +149,12 @@ pub const MULTIPLE_GAIN: f32 = 0.63;
 /// leaves a cloud in every direction, not only in the phase's lobes. It
 /// was 0.91 before the light volume, which now carries most of that
 /// light ([`FLUENCE_GAIN`]).
-pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.13;
+pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.135;
 /// The octaves scale with the sun's height as `sin(elevation)^MULTIPLE_SUN_POWER`.
 pub const MULTIPLE_SUN_POWER: f32 = 0.4;
 /// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
 /// zenith.
-pub const DIFFUSE_GAIN: f32 = 0.21;
+pub const DIFFUSE_GAIN: f32 = 0.17;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
 /// cloud, not the thin haze and wisps between clouds, which have little
@@ -178,17 +179,22 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
 
 /// The gain on the light volume's diffused sunlight
 /// ([`diffused_fluence`]; `FLUENCE_GAIN` in WGSL), fitted with the
-/// others: 1.06, where an exact diffusion would need 1 (the unscaled
-/// source, `e^{-τ}`, asked for 2.1).
-pub const FLUENCE_GAIN: f32 = 1.06;
+/// others: 0.91, where an exact diffusion would need 1 (1.06 before the
+/// flux's first-order term; the unscaled source, `e^{-τ}`, asked for 2.1).
+pub const FLUENCE_GAIN: f32 = 0.91;
 
 /// The sunlight diffused through the clouds, scattered toward the eye per
 /// unit scattering coefficient and per unit sun irradiance, from the
-/// light volume's fluence `phi` ([`super::light_volume::LightVolume`]):
-/// isotropic, `φ / 4π`, times [`FLUENCE_GAIN`].
+/// light volume's fluence `phi` and net flux `flux`
+/// ([`super::light_volume::LightVolume`]) toward the eye `to_eye`: the
+/// first-order radiance `(φ + 3 F·ω) / 4π` scattered by a phase of mean
+/// cosine `g` is `(φ + 3 g F·ω) / 4π`, times [`FLUENCE_GAIN`]. The flux
+/// term brightens the faces the diffused light leaves through (a backlit
+/// cloud's shaded side, a base seen from under it) over those it enters.
 #[inline]
-pub fn diffused_fluence(phi: f32) -> f32 {
-    FLUENCE_GAIN * phi / (4.0 * PI)
+pub fn diffused_fluence(phi: f32, flux: Vec3, to_eye: Vec3) -> f32 {
+    let first_order = 3.0 * PHASE_MEAN_COSINE * flux.dot(to_eye);
+    FLUENCE_GAIN * (phi + first_order).max(0.0) / (4.0 * PI)
 }
 
 /// Sun light scattered toward the eye per unit scattering coefficient in

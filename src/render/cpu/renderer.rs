@@ -152,7 +152,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// bottom and 0.35 at the top ([`ambient_light`]), times this, which
 /// stands for that light's own multiple scattering; fitted with the
 /// octaves and the diffused sunlight ([`super::lighting::sun_scattering`]).
-pub const AMBIENT_GAIN: f32 = 4.42;
+pub const AMBIENT_GAIN: f32 = 4.45;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4` and the
@@ -254,7 +254,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             };
             let scatter = sun
                 * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, octaves)
-                    + diffused_light(p, octaves, fr))
+                    + diffused_light(p, -dir, octaves, fr))
                 + ambient;
             let s = scatter * (sigma_t * ALBEDO);
             let step_t = (-sigma_t * h).exp();
@@ -286,14 +286,17 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     }
 }
 
-/// The light volume's diffused sunlight at `p` per unit scattering
-/// coefficient and sun irradiance ([`diffused_fluence`] of the frame's
-/// [`LightVolume`]): 0 without one or without multiple scattering
-/// (`octaves` 0).
+/// The light volume's diffused sunlight at `p` scattered toward the eye
+/// (`to_eye`, against the ray), per unit scattering coefficient and sun
+/// irradiance ([`diffused_fluence`] of the frame's [`LightVolume`]): 0
+/// without one or without multiple scattering (`octaves` 0).
 #[inline]
-pub fn diffused_light(p: Vec3, octaves: u32, fr: &Frame) -> f32 {
+pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
     match fr.light {
-        Some(v) if octaves > 0 => diffused_fluence(v.fluence_at(p, fr.density.map_extent_m)),
+        Some(v) if octaves > 0 => {
+            let (phi, flux) = v.light_at(p, fr.density.map_extent_m);
+            diffused_fluence(phi, flux, to_eye)
+        }
         _ => 0.0,
     }
 }

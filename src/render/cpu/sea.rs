@@ -227,7 +227,7 @@ pub fn reflected_clouds(
         let eta = ((x.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
         let scatter = sun
             * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves)
-                + diffused_light(x, q.octaves, fr))
+                + diffused_light(x, -r, q.octaves, fr))
             + ambient_light(sky_top, ground, eta);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= (-sigma_t * h).exp();

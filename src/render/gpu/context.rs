@@ -117,9 +117,10 @@ impl GpuContext {
         let row = size.width * bytes_per_texel;
         let padded =
             row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let rows = size.height * size.depth_or_array_layers;
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size: padded as u64 * size.height as u64,
+            size: padded as u64 * rows as u64,
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
@@ -142,8 +143,8 @@ impl GpuContext {
         );
         self.queue.submit([encoder.finish()]);
         let data = self.map_read(&buffer)?;
-        let mut out = Vec::with_capacity((row * size.height) as usize);
-        for y in 0..size.height as usize {
+        let mut out = Vec::with_capacity((row * rows) as usize);
+        for y in 0..rows as usize {
             let start = y * padded as usize;
             out.extend_from_slice(&data[start..start + row as usize]);
         }

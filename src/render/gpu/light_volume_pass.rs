@@ -81,6 +81,9 @@ pub struct LightVolumePass {
     pub read_group: wgpu::BindGroup,
     /// The fluence per cell (per unit sun irradiance).
     pub fluence: wgpu::Buffer,
+    /// What the cloud pass samples: per cell the fluence (r) and the net
+    /// flux (gba), half floats.
+    pub texture: wgpu::Texture,
     pipelines: Option<Pipelines>,
     stale: bool,
     builds: u32,
@@ -155,7 +158,9 @@ impl LightVolumePass {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D3,
             format: FLUENCE_FORMAT,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         let texture_view = bind::view(&texture);
@@ -233,6 +238,7 @@ impl LightVolumePass {
             read_layout,
             read_group,
             fluence,
+            texture,
             pipelines: None,
             stale: true,
             builds: 0,
@@ -277,6 +283,22 @@ impl LightVolumePass {
         let mut values: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
         values.truncate(self.grid.len());
         Ok(values)
+    }
+
+    /// The texture the cloud pass samples, read back to the CPU: per cell,
+    /// in the CPU's [`DiffusionGrid::index`] order, the fluence and the
+    /// net flux (waits for the GPU).
+    pub fn read_light(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>, GpuError> {
+        // The texture's texel (i, j, k) is cell (i, j, k); it reads back
+        // k-major (then j, then i), the grid's index is j-major.
+        let texels = ctx.read_rgba16f(&self.texture)?;
+        let (nx, ny) = (self.grid.cells.x as usize, self.grid.cells.y as usize);
+        let mut cells = vec![[0.0; 4]; self.grid.len()];
+        for (t, texel) in texels.into_iter().enumerate() {
+            let (i, j, k) = (t % nx, (t / nx) % ny, t / (nx * ny));
+            cells[self.grid.index(i as i32, j as i32, k as i32)] = texel;
+        }
+        Ok(cells)
     }
 
     /// Builds since the pass was made.

@@ -31,12 +31,12 @@ pub const LIGHT_VOLUME: &str = include_str!("../../../shaders/light_volume.wgsl"
 /// The light volume's compute entry points (after [`LIGHT_VOLUME`]).
 pub const LIGHT_VOLUME_BUILD: &str = include_str!("../../../shaders/light_volume_build.wgsl");
 
-/// `fluence_at` where there is no light volume: nothing diffused.
-const NO_LIGHT: &str = "fn fluence_at(p: vec3f) -> f32 {\n    return 0.0;\n}\n";
+/// `light_at` where there is no light volume: nothing diffused.
+const NO_LIGHT: &str = "fn light_at(p: vec3f) -> vec4f {\n    return vec4f(0.0);\n}\n";
 
 /// The cloud pass's bindings of the light volume (group 2: the fluence
 /// texture and its sampler) and its read.
-const LIGHT_READ: &str = "@group(2) @binding(0) var light_fluence: texture_3d<f32>;\n@group(2) @binding(1) var light_sampler: sampler;\n\n// The fluence at p per unit sun irradiance, read where p reads P (the\n// CPU's `LightVolume::fluence_at`): the texel centres are the cells'.\nfn fluence_at(p: vec3f) -> f32 {\n    let q = noise_point(p, warped_lookup(p.x, p.z));\n    let uvw = vec3f(q.x / frame.map.x, (q.y - frame.band.x) / (frame.band.y - frame.band.x), q.z / frame.map.x);\n    return textureSampleLevel(light_fluence, light_sampler, uvw, 0.0).r;\n}\n";
+const LIGHT_READ: &str = "@group(2) @binding(0) var light_fluence: texture_3d<f32>;\n@group(2) @binding(1) var light_sampler: sampler;\n\n// The fluence (x) and net flux (yzw) at p per unit sun irradiance, read\n// where p reads P (the CPU's `LightVolume::light_at`): the texel centres\n// are the cells'.\nfn light_at(p: vec3f) -> vec4f {\n    let q = noise_point(p, warped_lookup(p.x, p.z));\n    let uvw = vec3f(q.x / frame.map.x, (q.y - frame.band.x) / (frame.band.y - frame.band.x), q.z / frame.map.x);\n    return textureSampleLevel(light_fluence, light_sampler, uvw, 0.0);\n}\n";
 
 /// The shared functions with the sky model's: the physical atmosphere's
 /// tables (bindings 7 to 11 of group 0) when `physical`, else the
