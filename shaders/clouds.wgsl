@@ -50,20 +50,25 @@ const SHADOW_RAY_M: f32 = 12000.0;
 // SHADOW_STEP_FACTOR_MAX times SHADOW_STEPS (shadow_step_count).
 const SHADOW_STEP_SPAN_M: f32 = 2000.0;
 const SHADOW_STEP_FACTOR_MAX: f32 = 3.0;
+// Toward the sun a ray's shadow rays take up to FORWARD_STEP_BOOST more
+// steps, from FORWARD_COS_MIN to FORWARD_COS_MAX (forward_step_factor).
+const FORWARD_STEP_BOOST: f32 = 0.6;
+const FORWARD_COS_MIN: f32 = 0.5;
+const FORWARD_COS_MAX: f32 = 0.9;
 // Multiple scattering and sky light (the CPU's lighting.rs, renderer.rs).
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.8;
-const MULTIPLE_GAIN: f32 = 0.63;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.135;
+const MULTIPLE_GAIN: f32 = 0.74;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.063;
 const MULTIPLE_SUN_POWER: f32 = 0.4;
-const DIFFUSE_GAIN: f32 = 0.17;
+const DIFFUSE_GAIN: f32 = 0.155;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const FLUENCE_GAIN: f32 = 0.91;
+const FLUENCE_GAIN: f32 = 0.9;
 // The phase function's mean cosine (the light volume's diffusion and
 // the diffused light's first-order term).
 const PHASE_MEAN_COSINE: f32 = 0.525;
-const AMBIENT_GAIN: f32 = 4.45;
+const AMBIENT_GAIN: f32 = 4.46;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
@@ -372,12 +377,20 @@ fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
     return min(to_top, SHADOW_RAY_M);
 }
 
+// The factor on the shadow steps of a ray at cos_theta to the sun (the
+// CPU's `forward_step_factor`): up to 1 + FORWARD_STEP_BOOST toward the
+// sun, where the sunlight scattered once is most of a pixel's light.
+fn forward_step_factor(cos_theta: f32) -> f32 {
+    return 1.0 + FORWARD_STEP_BOOST * smoothstep(FORWARD_COS_MIN, FORWARD_COS_MAX, cos_theta);
+}
+
 // The steps of a shadow ray of `length` m: `steps` over SHADOW_STEP_SPAN_M
-// or less, in proportion beyond, at most SHADOW_STEP_FACTOR_MAX times
-// (the CPU's `shadow_step_count`).
-fn shadow_step_count(steps: u32, length: f32) -> u32 {
-    let factor = clamp(length / SHADOW_STEP_SPAN_M, 1.0, SHADOW_STEP_FACTOR_MAX);
-    return u32(ceil(f32(steps) * factor));
+// or less, in proportion beyond, times `forward`, at most
+// SHADOW_STEP_FACTOR_MAX times `steps` in all (the CPU's
+// `shadow_step_count`).
+fn shadow_step_count(steps: u32, length: f32, forward: f32) -> u32 {
+    let along = clamp(length / SHADOW_STEP_SPAN_M, 1.0, SHADOW_STEP_FACTOR_MAX);
+    return u32(ceil(f32(steps) * min(along * forward, SHADOW_STEP_FACTOR_MAX)));
 }
 
 // The sunlight diffused through the cloud layer, per unit scattering
@@ -741,6 +754,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let sky_top = sky_ambient(sun_dir) * 0.25;
     let ground = ground_up(sun_dir, SEA) * 0.25;
     let cos_theta = dot(dir, sun_dir);
+    let forward = forward_step_factor(cos_theta);
     var transmittance = 1.0;
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
@@ -850,7 +864,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 tau = 0.0;
                 shadow_t = 0.0;
                 shadow_length = shadow_ray_length(q, sun_dir);
-                shadow_count = shadow_step_count(SHADOW_STEPS, shadow_length);
+                shadow_count = shadow_step_count(SHADOW_STEPS, shadow_length, forward);
                 parts = shadow_parts(shadow_count);
                 k = 0u;
             }

@@ -77,7 +77,7 @@ fn the_gpu_light_volume_is_its_cpu_twin() {
         // What the cloud pass samples: the fluence again (as half floats)
         // and the net flux, against the CPU's over the same cells, the
         // flux's difference relative to the cell's fluence (the flux is
-        // at most a third of it, and crosses zero).
+        // at most FLUX_LIMIT of it, and crosses zero).
         let texels = pass.read_light(&ctx).expect("texture readback");
         assert_eq!(texels.len(), cpu.fluence.len());
         let (mut fluence_rel, mut flux_rel, mut flux_size) = (Vec::new(), Vec::new(), 0.0f64);

@@ -167,7 +167,7 @@ fn transmittance_is_in_unit_range_and_monotone_along_a_ray() {
     // transmittance of what is left only grows.
     for k in 0..50 {
         let start = Vec3::new(1234.0, 500.0, 777.0) + sun * (k as f32 * 40.0);
-        let t = sun_transmittance(start, sun, 64, 0.0, &f, &D);
+        let t = sun_transmittance(start, sun, 64, 1.0, 0.0, &f, &D);
         assert!((0.0..=1.0).contains(&t));
         if k > 0 {
             assert!(t >= prev - 1e-6, "step {k}: {t} < {prev}");
@@ -222,7 +222,7 @@ fn a_low_suns_shadow_ray_crosses_the_whole_band() {
                     * dt as f64
             })
             .sum();
-        let tau = sun_optical_depth(start, sun, 20, footprint, &f, &d) as f64;
+        let tau = sun_optical_depth(start, sun, 20, 1.0, footprint, &f, &d) as f64;
         assert!(exact > 1.0, "a real shadow: τ = {exact}");
         assert!(
             (tau / exact - 1.0).abs() < 0.05,

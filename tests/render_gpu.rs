@@ -7,7 +7,7 @@ mod common;
 
 use common::gpu;
 use cumulus::prepare::Prepared;
-use cumulus::render::cpu::lighting::{SHADOW_RAY_M, shadow_step_count};
+use cumulus::render::cpu::lighting::{SHADOW_RAY_M, forward_step_factor, shadow_step_count};
 use cumulus::render::cpu::renderer::{render_converged, render_linear, to_srgb8};
 use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::gpu::renderer::{
@@ -371,9 +371,9 @@ fn per_pixel_work_is_bounded_the_same_for_12_and_10000_parcels() {
         let mean = counts.iter().sum::<f32>() / counts.len() as f32;
         // One density sample per interval end, REFINE per touched interval,
         // and the shadow ray's samples per lit sample (at most
-        // SHADOW_STEP_FACTOR_MAX times shadow_steps, toward a low sun):
-        // nothing that grows with the parcel count.
-        let longest = shadow_step_count(q.shadow_steps, SHADOW_RAY_M);
+        // SHADOW_STEP_FACTOR_MAX times shadow_steps, toward a low sun or
+        // the sun itself): nothing that grows with the parcel count.
+        let longest = shadow_step_count(q.shadow_steps, SHADOW_RAY_M, forward_step_factor(1.0));
         let bound = 1 + q.steps * (1 + 4) + q.steps * 4 * longest;
         eprintln!(
             "{parcels} parcels: P {:.0} % covered, samples per pixel mean {mean:.1}, max {max}, bound {bound}",

@@ -4,8 +4,8 @@
 //! (docs/ground_truth: light that depends on the whole cloud, not on one
 //! ray toward the sun, is what the path tracer's deep cloud asks for).
 //!
-//! Built once per field, sun and density change, in three steps, each a
-//! WGSL compute entry of the same name in `shaders/light_volume.wgsl`:
+//! Built once per field, sun and density change, in four steps, each a
+//! WGSL function of the same name in `shaders/light_volume_build.wgsl`:
 //! 1. [`cell_extinction`]: the mean σ_t of each cell, the renderer's own
 //!    [`density_at`] averaged over eight points of the cell;
 //! 2. [`sun_depth`]: the optical depth from each cell's centre toward the
@@ -13,13 +13,17 @@
 //!    the sun's ray crosses it, plus the segment between);
 //! 3. [`relax`]: red-black over-relaxed Gauss-Seidel sweeps of
 //!    `-∇·(D ∇φ) + σ_a φ = ϖ σ_t e^{-τ_sun}` (the sunlight scattered once
-//!    as the source, `D = 1 / (3 σ_t (1 - g))`), from φ = 0, a fixed count.
+//!    as the source, `D = 1 / (3 σ_t (1 - g))`), from φ = 0, a fixed count;
+//! 4. [`light_flux`]: the net flux of that light, `F = -D ∇φ` (limited to
+//!    [`FLUX_LIMIT`] of φ; on the GPU inside the last entry,
+//!    `fluence_texture`, which writes φ and F into the texture the cloud
+//!    pass samples).
 //!
 //! The grid repeats across the domain as the clouds do; the band's floor
 //! and ceiling are vacuum. Clear air absorbs within about a cell: light
-//! that leaves a cloud does not come back into this term. The fluence is
-//! per unit sun irradiance; [`LightVolume::fluence_at`] reads it
-//! trilinearly, outside the domain where the density reads P
+//! that leaves a cloud does not come back into this term. The fluence and
+//! the flux are per unit sun irradiance; [`LightVolume::light_at`] reads
+//! them trilinearly, outside the domain where the density reads P
 //! ([`noise_point`]).
 
 use std::ops::{Add, Mul, Sub};
@@ -446,12 +450,13 @@ impl LightVolume {
     /// itself over the simulated domain), trilinearly.
     #[inline]
     pub fn fluence_at(&self, p: Vec3, map_extent_m: f32) -> f32 {
-        self.light_at(p, map_extent_m).0
+        let q = noise_point(p, warped_lookup(p.x, p.z, map_extent_m), map_extent_m);
+        read_cells(&self.fluence, &self.grid, q)
     }
 
     /// The fluence and the net flux at world point `p`, read as
-    /// [`Self::fluence_at`] reads the fluence (the warp moves, it does not
-    /// turn, so the flux keeps its direction).
+    /// [`Self::fluence_at`] reads the fluence (the warp moves a point and
+    /// shears the field only slightly: the flux keeps its direction).
     #[inline]
     pub fn light_at(&self, p: Vec3, map_extent_m: f32) -> (f32, Vec3) {
         let q = noise_point(p, warped_lookup(p.x, p.z, map_extent_m), map_extent_m);

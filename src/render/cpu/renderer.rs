@@ -9,7 +9,9 @@ use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::light_volume::LightVolume;
-use super::lighting::{diffused_fluence, integrate_step, sun_optical_depth, sun_scattering};
+use super::lighting::{
+    diffused_fluence, forward_step_factor, integrate_step, sun_optical_depth, sun_scattering,
+};
 use super::sea::sea_reflection_change;
 use super::sky::{
     AtmosphereConfig, SkyLight, aerial, background_radiance, ground_cloud_light, ground_up,
@@ -152,7 +154,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// bottom and 0.35 at the top ([`ambient_light`]), times this, which
 /// stands for that light's own multiple scattering; fitted with the
 /// octaves and the diffused sunlight ([`super::lighting::sun_scattering`]).
-pub const AMBIENT_GAIN: f32 = 4.45;
+pub const AMBIENT_GAIN: f32 = 4.46;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4` and the
@@ -213,6 +215,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     let sky_top = sky_ambient(sky, sun_dir) * 0.25;
     let ground = ground_up(sky, sun_dir, q.sea_wind_mps.is_some()) * 0.25;
     let cos = dir.dot(sun_dir);
+    let forward = forward_step_factor(cos);
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
     let mut depth_weighted = 0.0_f32;
@@ -243,7 +246,15 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             if sigma_t <= 0.0 {
                 continue;
             }
-            let tau_sun = sun_optical_depth(p, sun_dir, q.shadow_steps, footprint, &fr.fields, d);
+            let tau_sun = sun_optical_depth(
+                p,
+                sun_dir,
+                q.shadow_steps,
+                forward,
+                footprint,
+                &fr.fields,
+                d,
+            );
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
             // Sky light from above, darker toward the cloud base, and the
             // ground's from below.

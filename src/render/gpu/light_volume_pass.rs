@@ -3,7 +3,8 @@
 //! `shaders/light_volume_build.wgsl`). Built by compute passes of its
 //! own, submitted before the frame's, whenever P, the sun or the density
 //! changed ([`LightVolumePass::mark_stale`]), not per frame. The last
-//! step copies the fluence into a 3D texture (half floats), which the
+//! step writes the fluence and its net flux (`light_flux`) into an rgba
+//! 3D texture (half floats), which the
 //! cloud pass reads with one filtered fetch per lit sample (bind group
 //! 2): reading the buffer's eight corners by hand made the pass 37 %
 //! slower on lavapipe. It exists only with multiple scattering on
