@@ -445,18 +445,11 @@ impl LightVolume {
         }
     }
 
-    /// The fluence at world point `p`, per unit irradiance: where `p`
-    /// reads P and the cloud map ([`warped_lookup`], [`noise_point`]:
-    /// itself over the simulated domain), trilinearly.
-    #[inline]
-    pub fn fluence_at(&self, p: Vec3, map_extent_m: f32) -> f32 {
-        let q = noise_point(p, warped_lookup(p.x, p.z, map_extent_m), map_extent_m);
-        read_cells(&self.fluence, &self.grid, q)
-    }
-
-    /// The fluence and the net flux at world point `p`, read as
-    /// [`Self::fluence_at`] reads the fluence (the warp moves a point and
-    /// shears the field only slightly: the flux keeps its direction).
+    /// The fluence and the net flux at world point `p`, per unit
+    /// irradiance: where `p` reads P and the cloud map ([`warped_lookup`],
+    /// [`noise_point`]: itself over the simulated domain), trilinearly
+    /// (the warp moves a point and shears the field only slightly: the
+    /// flux keeps its direction).
     #[inline]
     pub fn light_at(&self, p: Vec3, map_extent_m: f32) -> (f32, Vec3) {
         let q = noise_point(p, warped_lookup(p.x, p.z, map_extent_m), map_extent_m);
