@@ -111,7 +111,7 @@ fn buffer_type(ty: wgpu::BufferBindingType, dynamic: bool) -> wgpu::BindingType 
 
 impl LightVolumePass {
     /// The volume for the density `d` (its grid, [`DiffusionGrid::new`]),
-    /// stale until its first [`Self::build`].
+    /// stale until its first [`Self::build_if_stale`].
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, d: &DensityParams) -> Self {
         let grid = DiffusionGrid::new(d);
         let cells = grid.len();
