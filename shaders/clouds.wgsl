@@ -59,16 +59,16 @@ const FORWARD_COS_MAX: f32 = 0.9;
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.8;
-const MULTIPLE_GAIN: f32 = 0.74;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.063;
+const MULTIPLE_GAIN: f32 = 0.78;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.13;
 const MULTIPLE_SUN_POWER: f32 = 0.4;
-const DIFFUSE_GAIN: f32 = 0.155;
+const DIFFUSE_GAIN: f32 = 0.1;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const FLUENCE_GAIN: f32 = 0.9;
+const FLUENCE_GAIN: f32 = 1.24;
 // The phase function's mean cosine (the light volume's diffusion and
 // the diffused light's first-order term).
 const PHASE_MEAN_COSINE: f32 = 0.525;
-const AMBIENT_GAIN: f32 = 4.46;
+const AMBIENT_GAIN: f32 = 4.25;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;

@@ -8,8 +8,9 @@
 // filters on the CPU.
 
 const LIGHT_RELAXATION: f32 = 1.7;
-const AIR_TRANSPORT_M: f32 = 200.0;
+const AIR_TRANSPORT_M: f32 = 2000.0;
 const CLOUD_EXTINCTION_MIN: f32 = 0.004;
+const CLEAR_AIR_LOSS_M: f32 = 1600.0;
 const LIGHT_SUN_MIN: f32 = 0.05;
 const FLUX_LIMIT: f32 = 0.63492066;
 
@@ -72,9 +73,9 @@ fn diffusion_coefficient(sigma_t: f32) -> f32 {
     return 1.0 / (3.0 * max((1.0 - PHASE_MEAN_COSINE) * sigma_t, 1.0 / AIR_TRANSPORT_M));
 }
 
-fn absorption(sigma_t: f32, cell_m: vec3f) -> f32 {
+fn absorption(sigma_t: f32) -> f32 {
     let clear = 1.0 - clamp(sigma_t / CLOUD_EXTINCTION_MIN, 0.0, 1.0);
-    return sigma_t * (1.0 - ALBEDO) + clear * 3.0 / (cell_m.x + cell_m.y + cell_m.z);
+    return sigma_t * (1.0 - ALBEDO) + clear / CLEAR_AIR_LOSS_M;
 }
 
 fn first_scattering(sigma_t: f32, tau_sun: f32) -> f32 {

@@ -116,7 +116,7 @@ fn relax(@builtin(global_invocation_id) id: vec3u) {
     let cell_m = diffusion_grid.cell_m.xyz;
     let s = light_cells[idx];
     let d = diffusion_coefficient(s);
-    var diagonal = absorption(s, cell_m);
+    var diagonal = absorption(s);
     var sum = first_scattering(s, light_tau[idx]);
     let ny = i32(diffusion_grid.cells.y);
     let offsets = array<vec3i, 6>(

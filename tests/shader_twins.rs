@@ -159,6 +159,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("LIGHT_RELAXATION", light_volume::LIGHT_RELAXATION as f64),
         ("PHASE_MEAN_COSINE", light_volume::PHASE_MEAN_COSINE as f64),
         ("AIR_TRANSPORT_M", light_volume::AIR_TRANSPORT_M as f64),
+        ("CLEAR_AIR_LOSS_M", light_volume::CLEAR_AIR_LOSS_M as f64),
         (
             "CLOUD_EXTINCTION_MIN",
             light_volume::CLOUD_EXTINCTION_MIN as f64,

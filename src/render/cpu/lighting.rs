@@ -173,17 +173,17 @@ pub const OCTAVE_ECCENTRICITY: f32 = 0.8;
 /// function's lobes at the octave's eccentricity) at a sun in the zenith
 /// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`],
 /// [`FLUENCE_GAIN`] and the ambient's gain are; docs/ground_truth).
-pub const MULTIPLE_GAIN: f32 = 0.74;
+pub const MULTIPLE_GAIN: f32 = 0.78;
 /// The gain on the octaves' isotropic light: light scattered many times
 /// leaves a cloud in every direction, not only in the phase's lobes. It
 /// was 0.91 before the light volume, which now carries most of that
 /// light ([`FLUENCE_GAIN`]).
-pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.063;
+pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.13;
 /// The octaves scale with the sun's height as `sin(elevation)^MULTIPLE_SUN_POWER`.
 pub const MULTIPLE_SUN_POWER: f32 = 0.4;
 /// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
 /// zenith.
-pub const DIFFUSE_GAIN: f32 = 0.155;
+pub const DIFFUSE_GAIN: f32 = 0.1;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
 /// cloud, not the thin haze and wisps between clouds, which have little
@@ -208,9 +208,12 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
 
 /// The gain on the light volume's diffused sunlight
 /// ([`diffused_fluence`]; `FLUENCE_GAIN` in WGSL), fitted with the
-/// others: 0.9, where an exact diffusion would need 1 (1.06 before the
-/// flux's first-order term; the unscaled source, `e^{-τ}`, asked for 2.1).
-pub const FLUENCE_GAIN: f32 = 0.9;
+/// others: 1.24, where an exact diffusion would need 1. It was 0.9 while
+/// clear air absorbed the light within a cell (1.06 before the flux's
+/// first-order term; the unscaled source, `e^{-τ}`, asked for 2.1); the
+/// light volume's cells, 80 m, still blur a cloud's lit surface into
+/// its shaded inside.
+pub const FLUENCE_GAIN: f32 = 1.24;
 
 /// The sunlight diffused through the clouds, scattered toward the eye per
 /// unit scattering coefficient and per unit sun irradiance, from the

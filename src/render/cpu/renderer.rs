@@ -154,7 +154,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// bottom and 0.35 at the top ([`ambient_light`]), times this, which
 /// stands for that light's own multiple scattering; fitted with the
 /// octaves and the diffused sunlight ([`super::lighting::sun_scattering`]).
-pub const AMBIENT_GAIN: f32 = 4.46;
+pub const AMBIENT_GAIN: f32 = 4.25;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4` and the
