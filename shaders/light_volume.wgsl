@@ -7,7 +7,7 @@
 // src/render/gpu/shaders.rs), filtered by the hardware as `read_cells`
 // filters on the CPU.
 
-const LIGHT_RELAXATION: f32 = 1.7;
+const LIGHT_RELAXATION: f32 = 1.8;
 const AIR_TRANSPORT_M: f32 = 2000.0;
 const CLOUD_EXTINCTION_MIN: f32 = 0.004;
 const CLEAR_AIR_LOSS_M: f32 = 1600.0;
