@@ -3,6 +3,21 @@
 
 use super::*;
 
+/// The cells' extinction of a 1 km ball of cloud (0.03/m) around
+/// `centre`, clear air elsewhere.
+fn cloud_ball(g: &DiffusionGrid, centre: Vec3) -> Vec<f32> {
+    (0..g.len())
+        .map(|idx| {
+            let (i, j, k) = g.cell(idx);
+            if (g.centre(i, j, k) - centre).length() < 500.0 {
+                0.03
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 fn grid(cells: UVec3, cell_m: f32) -> DiffusionGrid {
     DiffusionGrid {
         cells,
@@ -67,13 +82,7 @@ fn a_uniform_layer_diffuses_as_the_slab_solution() {
 fn the_sweeps_settle_on_a_cloud() {
     let g = grid(UVec3::new(32, 20, 32), 80.0);
     let centre = g.centre(16, 10, 16);
-    let sigma: Vec<f32> = (0..g.len())
-        .map(|idx| {
-            let (i, j, k) = g.cell(idx);
-            let r = (g.centre(i, j, k) - centre).length();
-            if r < 500.0 { 0.03 } else { 0.0 }
-        })
-        .collect();
+    let sigma = cloud_ball(&g, centre);
     let sun = Vec3::new(0.5, 0.8, 0.2).normalize();
     let fast = LightVolume::solve(g, &sigma, sun, LIGHT_SWEEPS);
     let slow = LightVolume::solve(g, &sigma, sun, 2000);
@@ -112,20 +121,8 @@ fn the_sweeps_settle_on_a_cloud() {
 #[test]
 fn a_cloud_lights_its_neighbour_across_clear_air() {
     let g = grid(UVec3::new(48, 20, 32), 80.0);
-    let ball = |c: Vec3| -> Vec<f32> {
-        (0..g.len())
-            .map(|idx| {
-                let (i, j, k) = g.cell(idx);
-                if (g.centre(i, j, k) - c).length() < 500.0 {
-                    0.03
-                } else {
-                    0.0
-                }
-            })
-            .collect()
-    };
-    let lone = ball(g.centre(28, 10, 16));
-    let pair: Vec<f32> = ball(g.centre(14, 10, 16))
+    let lone = cloud_ball(&g, g.centre(28, 10, 16));
+    let pair: Vec<f32> = cloud_ball(&g, g.centre(14, 10, 16))
         .iter()
         .zip(&lone)
         .map(|(a, b)| a.max(*b))
