@@ -59,16 +59,17 @@ const FORWARD_COS_MAX: f32 = 0.9;
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.8;
-const MULTIPLE_GAIN: f32 = 0.78;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.13;
+const MULTIPLE_GAIN: f32 = 0.79;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.15;
 const MULTIPLE_SUN_POWER: f32 = 0.4;
 const DIFFUSE_GAIN: f32 = 0.1;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const FLUENCE_GAIN: f32 = 1.24;
+const FLUENCE_GAIN: f32 = 1.25;
 // The phase function's mean cosine (the light volume's diffusion and
 // the diffused light's first-order term).
 const PHASE_MEAN_COSINE: f32 = 0.525;
-const AMBIENT_GAIN: f32 = 4.25;
+const AMBIENT_GAIN: f32 = 4.34;
+const GROUND_LIGHT_GAIN: f32 = 4.15;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
@@ -433,9 +434,10 @@ fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32, sigma_t: f32) -> f3
 }
 
 // The sky's and the ground's light scattered at height fraction `eta`
-// (the CPU's `ambient_light`).
+// (the CPU's `ambient_light`): the sky's from 0.35 at the band's bottom
+// to all at its top, the ground's from all at the bottom to none at the top.
 fn ambient_light(sky_top: vec3f, ground: vec3f, eta: f32) -> vec3f {
-    return (sky_top * (0.35 + 0.65 * eta) + ground * (1.0 - 0.65 * eta)) * AMBIENT_GAIN;
+    return sky_top * ((0.35 + 0.65 * eta) * AMBIENT_GAIN) + ground * ((1.0 - eta) * GROUND_LIGHT_GAIN);
 }
 
 fn integrate_step(s: vec3f, sigma_t: f32, dt: f32) -> vec3f {

@@ -107,6 +107,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("DIFFUSE_GAIN", lighting::DIFFUSE_GAIN as f64),
         ("DIFFUSE_DEPTH_M", lighting::DIFFUSE_DEPTH_M as f64),
         ("AMBIENT_GAIN", renderer::AMBIENT_GAIN as f64),
+        ("GROUND_LIGHT_GAIN", renderer::GROUND_LIGHT_GAIN as f64),
         ("GROUND_SHADOW_STEPS", renderer::GROUND_SHADOW_STEPS as f64),
         ("RAY_DEPTH", cumulus::render::camera::RAY_DEPTH as f64),
         // shaders/sky_luts.wgsl (PI above is shared).

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Fits the light's four gains (the octaves' forward and isotropic
-parts, the diffused sunlight's, the ambient's) on the renderer's own
+"""Fits the light's six gains (the octaves' forward and isotropic
+parts, the diffused sunlight's, the light volume's, the sky's and the
+ground's) on the renderer's own
 images, against the path tracer's references.
 
     python3 docs/ground_truth/compare.py --width 80 --height 60 --spp 1024 --cells 1024 \\
@@ -15,7 +16,12 @@ candidate is scored in milliseconds. Prints, per fit, the gains and each
 view's mean relative luminance error, bias, tops ratio and red over
 blue (ours over Mitsuba's) on compare.py's cloud pixels. Fits: least
 squares on the relative error; Nelder-Mead on the summed per-pixel
-errors; the same plus |log| of the red-over-blue ratios.
+errors; the same plus |log| of the red-over-blue ratios (then Powell),
+optionally with the brightest tops held near 1 and some gains held. The
+shipped gains (2026-12-04):
+
+    python3 docs/ground_truth/fit_gains.py --bins /tmp/parts --arrays /tmp/gt/arrays \
+        --colour-weight 0.1 --tops-band 0.095 --hold di=0.1
 """
 
 import argparse
@@ -28,10 +34,10 @@ from scipy.optimize import minimize
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import compare as C  # noqa: E402
-from surrogate import FIVE, shipped_gains  # noqa: E402
+from surrogate import SIX, shipped_gains  # noqa: E402
 
 Y = np.array([0.2126, 0.7152, 0.0722])
-PARTS = ["mf", "mi", "di", "fl", "am"]
+PARTS = ["mf", "mi", "di", "fl", "am", "gr"]
 
 
 def render(binary, name, width, height, ss, extra, tmp):
@@ -93,6 +99,11 @@ def main():
                     help="a [render] key for our renders (e.g. shadow_steps=32)")
     ap.add_argument("--colour-weight", type=float, default=1.0,
                     help="the weight of the colour term in the last fit (default 1)")
+    ap.add_argument("--tops-band", type=float, default=None, metavar="FRACTION",
+                    help="in the last fit, a penalty (5 per unit) on each view's brightest-tops "
+                         "ratio outside 1 ± FRACTION (the shipped fit: 0.095)")
+    ap.add_argument("--hold", action="append", default=[], metavar="PART=GAIN",
+                    help="hold a part's gain in the last fit (e.g. di=0.1); repeatable")
     ap.add_argument("--cache", help="keep each render here, keyed by the binary's size and "
                                     "time and the --set keys: a rebuilt part renders again, "
                                     "the others are read back")
@@ -110,8 +121,8 @@ def main():
             data[name] = (truth[cloud], imgs["zero"], parts)
             print(f"{name}: rendered", flush=True)
     # MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, DIFFUSE_GAIN, FLUENCE_GAIN,
-    # AMBIENT_GAIN, as the Rust source has them.
-    shipped = np.array(shipped_gains(FIVE))
+    # AMBIENT_GAIN, GROUND_LIGHT_GAIN, as the Rust source has them.
+    shipped = np.array(shipped_gains(SIX))
     show("shipped", data, shipped)
     X = np.concatenate([np.einsum("nck,c->nk", p, Y) / (t @ Y)[:, None]
                         for t, z, p in data.values()])
@@ -126,9 +137,31 @@ def main():
                    method="Nelder-Mead", options=nm)
     show("per-pixel errors", data, np.abs(fit.x))
     w = a.colour_weight
-    fit = minimize(lambda g: sum(s[0] + w * abs(np.log(s[3])) for s in scores(data, np.abs(g))),
-                   start, method="Nelder-Mead", options=nm)
-    show(f"per-pixel errors and colour (weight {w})", data, np.abs(fit.x))
+    held = {PARTS.index(k): float(v) for k, v in (h.split("=", 1) for h in a.hold)}
+
+    def gains(g):
+        g = np.abs(g)
+        for i, v in held.items():
+            g[i] = v
+        return g
+
+    def objective(g):
+        total = 0.0
+        for e, _, tops, rb in scores(data, gains(g)):
+            total += e + w * abs(np.log(rb))
+            if a.tops_band is not None:
+                total += 5 * max(0.0, abs(tops - 1) - a.tops_band)
+        return total
+
+    fit = minimize(objective, start, method="Nelder-Mead", options=nm)
+    # Powell from there: Nelder-Mead stalls in six dimensions.
+    fit = minimize(objective, np.abs(fit.x), method="Powell", options={"maxiter": 20000})
+    label = f"per-pixel errors and colour (weight {w})"
+    if a.tops_band is not None:
+        label += f", tops within {a.tops_band}"
+    if held:
+        label += ", held " + " ".join(a.hold)
+    show(label, data, gains(fit.x))
 
 
 if __name__ == "__main__":

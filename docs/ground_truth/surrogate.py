@@ -159,10 +159,13 @@ def octaves(s, a, b, c, n=3):
 
 
 def sky(s, cosine=False):
-    """ambient_light without its gain: the upper sky's light, 0.35 of it at
-    the band's bottom, and the ground's, 0.35 of it at the top (1/4 of
-    each hemisphere's mean radiance; cosine: the upper one weighted by the
-    cosine from the zenith, as sky_ambient is since 2026-12-03)."""
+    """ambient_light without its gain, as it was when these models were
+    chosen: the upper sky's light, 0.35 of it at the band's bottom, and
+    the ground's, 0.35 of it at the top (1/4 of each hemisphere's mean
+    radiance; cosine: the upper one weighted by the cosine from the
+    zenith, as sky_ambient is since 2026-12-03). Since 2026-12-04 the
+    renderer's ground light falls to none at the top, under its own gain
+    (GROUND_LIGHT_GAIN; fit_gains.py fits it)."""
     up = s["up_cos"] if cosine else s["up"]
     return up / 4 * (0.35 + 0.65 * s["eta"]) + s["down"] / 4 * (1 - 0.65 * s["eta"])
 
@@ -235,12 +238,14 @@ def diffusion_fluence(vol, side, positions, down=2, air_mfp_m=200.0, cloud_sigma
 
 FOUR = ("MULTIPLE_GAIN", "MULTIPLE_ISOTROPIC_GAIN", "DIFFUSE_GAIN", "AMBIENT_GAIN")
 FIVE = ("MULTIPLE_GAIN", "MULTIPLE_ISOTROPIC_GAIN", "DIFFUSE_GAIN", "FLUENCE_GAIN", "AMBIENT_GAIN")
+SIX = FIVE + ("GROUND_LIGHT_GAIN",)
 
 
 def shipped_gains(names=FOUR):
     """The gains the renderer ships with, read from its source: by
     default the octaves' forward and isotropic gains, the diffused
-    light's and the ambient's (`FIVE` adds the light volume's)."""
+    light's and the ambient's (`FIVE` adds the light volume's, `SIX`
+    the ground light's)."""
     import re
 
     consts = {}
