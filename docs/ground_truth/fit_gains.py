@@ -20,7 +20,7 @@ errors; the same plus |log| of the red-over-blue ratios (then Powell),
 optionally with the brightest tops held near 1 and some gains held. The
 shipped gains (2026-12-04):
 
-    python3 docs/ground_truth/fit_gains.py --bins /tmp/parts --arrays /tmp/gt/arrays \
+    python3 docs/ground_truth/fit_gains.py --bins /tmp/parts --arrays /tmp/gt/arrays \\
         --colour-weight 0.1 --tops-band 0.095 --hold di=0.1
 """
 
@@ -109,6 +109,13 @@ def main():
                                     "the others are read back")
 
     a = ap.parse_args()
+    held = {}
+    for h in a.hold:
+        k, _, v = h.partition("=")
+        try:
+            held[PARTS.index(k)] = float(v)
+        except ValueError:
+            sys.exit(f"--hold {h}: expected PART=GAIN, a number, with PART one of {', '.join(PARTS)}")
     extra = dict(kv.split("=", 1) for kv in a.set)
     data = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -137,7 +144,6 @@ def main():
                    method="Nelder-Mead", options=nm)
     show("per-pixel errors", data, np.abs(fit.x))
     w = a.colour_weight
-    held = {PARTS.index(k): float(v) for k, v in (h.split("=", 1) for h in a.hold)}
 
     def gains(g):
         g = np.abs(g)

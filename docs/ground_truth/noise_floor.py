@@ -12,10 +12,11 @@ With `--ours DIR` (compare.py's `--arrays` output, same size and sample
 count) it also scores our render against each of the two and against
 their mean, and estimates our error against a noise-free reference by
 taking the reference's noise out in quadrature (exact for independent
-Gaussian errors, an estimate otherwise). With compare.py's `--cache` and
+Gaussian errors; where our error is a systematic offset it reads low,
+0.85 of an offset as large as the noise). With compare.py's `--cache` and
 `--cells`, the first render is compare.py's own:
 
-    python3 docs/ground_truth/noise_floor.py --spp 1024 --cells 1024 --cache /tmp/gt \
+    python3 docs/ground_truth/noise_floor.py --spp 1024 --cells 1024 --cache /tmp/gt \\
         --seed-offset 5000 --views high_sun,side --ours /tmp/gt/arrays
 
 Same setup as compare.py (Mitsuba 3.9.1, DRJIT_LIBLLVM_PATH on Debian 12).
@@ -46,11 +47,20 @@ def main():
     ap.add_argument("--seed-offset", type=int, default=1000,
                     help="the second render's seeds start here (the first's at 0)")
     ap.add_argument("--cache", default=None,
-                    help="compare.py's --cache: the first render is read from it when there, "
-                         "the second kept beside it")
+                    help="compare.py's --cache (needs --cells): the first render is compare.py's "
+                         "own when there (this script never writes that one), the second is "
+                         "read from or kept beside it under a name with its seeds")
     ap.add_argument("--ours", default=None,
                     help="compare.py --arrays output (VIEW_ours.npy): score ours against both")
     a = ap.parse_args()
+    if a.cache and not a.cells:
+        sys.exit("--cache: give --cells as well (compare.py's cache names its grid)")
+    # Each render is passes of 16 samples seeded 0, 1, ... (compare.py's
+    # mitsuba_render): the second's seeds must not reach into the first's.
+    passes = max(1, (a.spp + 15) // 16)
+    if a.seed_offset < passes:
+        sys.exit(f"--seed-offset {a.seed_offset}: at least {passes} at {a.spp} samples, "
+                 "or the two renders share seeds")
     import mitsuba as mi
 
     mi.set_variant("llvm_ad_rgb")
@@ -79,7 +89,7 @@ def main():
                 mi.render = lambda s, spp=None, seed=0, **k: render(s, spp=spp, seed=seed + offset, **k)
                 renders.append(C.mitsuba_render(vol, sky, side, a.spp, a.width, a.height))
                 mi.render = render
-                if cached:
+                if cached and offset:
                     np.save(cached, renders[-1])
             cloud = C.cloud_pixels(name, vol, side, a.width, a.height)[0]
             y1, y2 = C.luminance(renders[1]), C.luminance(renders[0])

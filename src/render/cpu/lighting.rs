@@ -172,7 +172,8 @@ pub const OCTAVE_ECCENTRICITY: f32 = 0.8;
 /// The gain on the octaves' forward-scattered light (the phase
 /// function's lobes at the octave's eccentricity) at a sun in the zenith
 /// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`],
-/// [`FLUENCE_GAIN`] and the ambient's gain are; docs/ground_truth).
+/// [`FLUENCE_GAIN`] and the sky's and the ground's gains are;
+/// docs/ground_truth).
 pub const MULTIPLE_GAIN: f32 = 0.79;
 /// The gain on the octaves' isotropic light: light scattered many times
 /// leaves a cloud in every direction, not only in the phase's lobes. It
