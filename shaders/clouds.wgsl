@@ -58,18 +58,18 @@ const FORWARD_COS_MAX: f32 = 0.9;
 // Multiple scattering and sky light (the CPU's lighting.rs, renderer.rs).
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
-const OCTAVE_ECCENTRICITY: f32 = 0.8;
-const MULTIPLE_GAIN: f32 = 0.79;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.15;
+const OCTAVE_ECCENTRICITY: f32 = 0.9;
+const MULTIPLE_GAIN: f32 = 0.6;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.42;
 const MULTIPLE_SUN_POWER: f32 = 0.4;
 const DIFFUSE_GAIN: f32 = 0.1;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const FLUENCE_GAIN: f32 = 1.25;
+const FLUENCE_GAIN: f32 = 1.23;
 // The phase function's mean cosine (the light volume's diffusion and
 // the diffused light's first-order term).
 const PHASE_MEAN_COSINE: f32 = 0.525;
-const AMBIENT_GAIN: f32 = 4.34;
-const GROUND_LIGHT_GAIN: f32 = 4.15;
+const AMBIENT_GAIN: f32 = 4.3;
+const GROUND_LIGHT_GAIN: f32 = 4.18;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
