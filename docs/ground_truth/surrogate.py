@@ -377,8 +377,9 @@ def decompose(data):
     volume (decomposition.csv was made with it then), split in two, each
     against its part of the path tracer's. It reads today's four gains
     of that model from the source, but has neither the light volume's
-    term nor the ground's own gain and profile (2026-12-04): it does not
-    split today's model. The parts: the sun's (single scattering, the octaves and
+    term nor the ground's own gain and profile (2026-12-04), and its
+    octaves keep the eccentricity factor 0.8 where today's gains were
+    fitted at 0.9: it does not split today's model. The parts: the sun's (single scattering, the octaves and
     the diffused light) against the render of the sun alone, and the
     sky's (the ambient and the background through the cloud) against the
     full render less it. Per view: the parts' means, their mean relative
