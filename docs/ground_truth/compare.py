@@ -207,6 +207,14 @@ def read_vol(path):
     return np.frombuffer(raw[48:], "<f4").reshape(nz, ny, nx)
 
 
+def cache_key(name, width, height, spp, cells, suffix=""):
+    """The file name a Mitsuba render of view `name` is cached under
+    (`--cache`; noise_floor.py, surrogate.py and ground_shadow.py use
+    the same names): `suffix` tells apart renders of other settings
+    (`_single`, a second render's `_seed5000`)."""
+    return f"{name}_{width}x{height}_{spp}spp_{cells}cells{suffix}.npy"
+
+
 def mitsuba_render(vol_path, sky_path, side, spp, width, height, single=False, sky=None,
                    ground=None):
     """Mitsuba's render of the exported volume: all orders of scattering
@@ -337,7 +345,8 @@ def main():
             side = json.load(open(vol[:-4] + ".json"))
             ours = read_exr(ours_path)
             ours = ours.reshape(a.height, ss, a.width, ss, 3).mean(axis=(1, 3))
-            key = f"{name}_{a.width}x{a.height}_{a.spp}spp_{a.cells}cells{'_single' if a.single_scattering else ''}.npy"
+            key = cache_key(name, a.width, a.height, a.spp, a.cells,
+                            "_single" if a.single_scattering else "")
             cached = os.path.join(a.cache, key) if a.cache else None
             if cached and os.path.exists(cached):
                 truth = np.load(cached)

@@ -89,7 +89,7 @@ def main():
                 os.remove(scene)
             side = json.load(open(vol[:-4] + ".json"))
             ours = compare.read_exr(ours_path)
-            key = f"{name}_{a.width}x{a.height}_{a.spp}spp_{a.cells}cells.npy"
+            key = compare.cache_key(name, a.width, a.height, a.spp, a.cells)
             cached = os.path.join(a.cache, key) if a.cache else None
             if cached and os.path.exists(cached):
                 mi_img = np.load(cached)

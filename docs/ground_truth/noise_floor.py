@@ -80,8 +80,8 @@ def main():
             renders = []
             for offset in (0, a.seed_offset):
                 # compare.py's cache key; the second render's names its seeds.
-                key = (f"{name}_{a.width}x{a.height}_{a.spp}spp_{a.cells}cells"
-                       + (f"_seed{offset}" if offset else "") + ".npy")
+                key = C.cache_key(name, a.width, a.height, a.spp, a.cells,
+                                  f"_seed{offset}" if offset else "")
                 cached = os.path.join(a.cache, key) if a.cache and a.cells else None
                 if cached and os.path.exists(cached):
                     renders.append(np.load(cached))

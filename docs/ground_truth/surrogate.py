@@ -301,7 +301,7 @@ def main():
     data = {}
     with tempfile.TemporaryDirectory() as tmp:
         for name, base, el, az, yaw in [v for v in C.VIEWS if v[0] in a.views.split(",")]:
-            ref = os.path.join(a.cache, f"{name}_{a.width}x{a.height}_{a.spp}spp_{a.cells}cells.npy")
+            ref = os.path.join(a.cache, C.cache_key(name, a.width, a.height, a.spp, a.cells))
             if not os.path.exists(ref):
                 sys.exit(f"{ref}: no cached reference; run compare.py with --cache {a.cache} "
                          f"and the same --width/--height/--spp/--cells first")
@@ -379,10 +379,10 @@ def decompose(data):
     of that model from the source, but has neither the light volume's
     term nor the ground's own gain and profile (2026-12-04), and its
     octaves keep the eccentricity factor 0.8 where today's gains were
-    fitted at 0.9: it does not split today's model. The parts: the sun's (single scattering, the octaves and
-    the diffused light) against the render of the sun alone, and the
-    sky's (the ambient and the background through the cloud) against the
-    full render less it. Per view: the parts' means, their mean relative
+    fitted at 0.9: it does not split today's model. The parts: the sun's
+    (single scattering, the octaves and the diffused light) against the
+    render of the sun alone, and the sky's (the ambient and the
+    background through the cloud) against the full render less it. Per view: the parts' means, their mean relative
     error and bias on the cloud pixels, the sun part's bias on each fifth
     of the pixels ranked by the optical depth toward the sun (at the
     pixel's samples, weighted as the camera sees them), and the ambient
