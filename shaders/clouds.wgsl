@@ -77,8 +77,10 @@ const GROUND_CLOUD_LIGHT: f32 = 0.53;
 const GROUND_SHADOW_STEPS: u32 = 12u;
 // The sea's reflection: reflected rays a pixel, the uniform steps of each
 // and their shadow samples, the lowest elevation the waves send one to.
-const REFLECTION_RAYS: u32 = 6u;
+const REFLECTION_RAYS: u32 = 12u;
 const REFLECTION_STEPS: u32 = 4u;
+const REFLECTION_STEPS_MAX: u32 = 16u;
+const REFLECTION_STEP_M: f32 = 300.0;
 const REFLECTION_SHADOW_STEPS: u32 = 2u;
 const REFLECTION_MIN_ELEVATION: f32 = 0.01;
 // The golden ratio's fraction (the CPU's sampling::GOLDEN).
@@ -613,6 +615,13 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
     return sum / f32(REFLECTION_RAYS);
 }
 
+// The steps of a reflected ray's march across `length` m of the band: one
+// per REFLECTION_STEP_M, REFLECTION_STEPS to REFLECTION_STEPS_MAX (the
+// CPU's `reflection_step_count`).
+fn reflection_step_count(length: f32) -> u32 {
+    return clamp(u32(max(ceil(length / REFLECTION_STEP_M), 0.0)), REFLECTION_STEPS, REFLECTION_STEPS_MAX);
+}
+
 // The clouds along one ray `r` the sea reflects from `p`, `t_sea` from the
 // eye (rgb premultiplied, a its transmittance through the band): a
 // coarser twin of march_ray (the CPU's `reflected_clouds`).
@@ -623,10 +632,11 @@ fn reflected_clouds(p: vec3f, r: vec3f, t_sea: f32, dither: f32, sun_dir: vec3f,
     }
     let spread = frame.cam_pos.w;
     let cos_theta = dot(r, sun_dir);
-    let h = (seg.y - seg.x) / f32(REFLECTION_STEPS);
+    let steps = reflection_step_count(seg.y - seg.x);
+    let h = (seg.y - seg.x) / f32(steps);
     var transmittance = 1.0;
     var light = vec3f(0.0);
-    for (var i = 0u; i < REFLECTION_STEPS; i++) {
+    for (var i = 0u; i < steps; i++) {
         let t = seg.x + (f32(i) + dither) * h;
         let x = p + r * t;
         let sigma_t = density_at(x, true, (spread + blur) * (t_sea + t));

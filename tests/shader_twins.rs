@@ -146,6 +146,8 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("REFLECTION_RAYS", sea::REFLECTION_RAYS as f64),
         ("GROUND_CLOUD_LIGHT", sky::GROUND_CLOUD_LIGHT as f64),
         ("REFLECTION_STEPS", sea::REFLECTION_STEPS as f64),
+        ("REFLECTION_STEPS_MAX", sea::REFLECTION_STEPS_MAX as f64),
+        ("REFLECTION_STEP_M", sea::REFLECTION_STEP_M as f64),
         (
             "REFLECTION_MIN_ELEVATION",
             sea::REFLECTION_MIN_ELEVATION as f64,

@@ -353,7 +353,11 @@ def main():
             else:
                 truth = mitsuba_render(vol, sky, side, a.spp, a.width, a.height, a.single_scattering)
                 if cached:
-                    np.save(cached, truth)
+                    # Written whole, then renamed: an interrupted run
+                    # leaves no half-written entry for the next to read.
+                    os.makedirs(a.cache, exist_ok=True)
+                    np.save(cached + ".tmp.npy", truth)
+                    os.replace(cached + ".tmp.npy", cached)
             cloud, tau, near_sun = cloud_pixels(name, vol, side, a.width, a.height)
             yo, ym = luminance(ours), luminance(truth)
             rel = (yo - ym) / np.maximum(ym, 1e-6)
