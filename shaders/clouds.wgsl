@@ -565,6 +565,23 @@ fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
     return mirror + s * log(q / (1.0 - q));
 }
 
+// A wave's slope across the line of sight at the quantile `u`: a logistic
+// of Cox and Munk's deviation in one direction (the CPU's `cross_slope`).
+fn cross_slope(wind_mps: f32, u: f32) -> f32 {
+    let deviation = sqrt(0.5 * (0.003 + 0.00512 * max(wind_mps, 0.0)));
+    let s = deviation * sqrt(3.0) / PI;
+    let q = clamp(u, 1e-6, 1.0 - 1e-6);
+    return s * log(q / (1.0 - q));
+}
+
+// The ray a wave sends up from the sea, seen along a ray falling at
+// `mirror` radians along `across`: rising at elevation `e`, turned
+// sideways by `2 cross sin(mirror)` (the CPU's `reflected_ray`).
+fn reflected_ray(across: vec3f, mirror: f32, e: f32, cross: f32) -> vec3f {
+    let side = vec3f(-across.z, 0.0, across.x);
+    return normalize(across * cos(e) + side * (2.0 * cross * sin(mirror)) + vec3f(0.0, sin(e), 0.0));
+}
+
 // The sky the flat sea mirrors along `dir` (the CPU's `mirrored_sky`).
 fn mirrored_sky(dir: vec3f, sun_dir: vec3f) -> vec3f {
     let mu = max(-dir.y, 1e-3);
@@ -609,7 +626,8 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
     for (var k = 0u; k < REFLECTION_RAYS; k++) {
         let u = (f32(k) + dither) / f32(REFLECTION_RAYS);
         let e = reflected_elevation(mirror, SEA_WIND_MPS, u);
-        let r = across * cos(e) + vec3f(0.0, sin(e), 0.0);
+        let cross = cross_slope(SEA_WIND_MPS, fract((f32(k) + 0.5) * GOLDEN + step_dither));
+        let r = reflected_ray(across, mirror, e, cross);
         sum += reflected_clouds(p, r, t_sea, step_dither, sun_dir, sun, sky_top, ground, blur);
     }
     return sum / f32(REFLECTION_RAYS);

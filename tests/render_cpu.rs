@@ -13,8 +13,8 @@ use cumulus::render::cpu::renderer::{
     ALBEDO, Frame, Quality, flat_ground_shadow, march_ray, render_linear, to_srgb8,
 };
 use cumulus::render::cpu::sea::{
-    REFLECTION_MIN_ELEVATION, ReflectionLight, reflected_clouds, reflected_elevation,
-    sea_reflection,
+    REFLECTION_MIN_ELEVATION, ReflectionLight, cross_slope, reflected_clouds, reflected_elevation,
+    reflected_ray, sea_reflection,
 };
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, SkyModel, background_radiance, sun_direction, sun_light_at,
@@ -579,6 +579,51 @@ fn the_waves_spread_the_reflected_rays_elevation() {
                 "wind {wind}: {low}"
             );
         }
+    }
+}
+
+/// The waves turn the reflected ray sideways too: a facet tilted across
+/// the line of sight by `s` sends the ray `2 s sin(mirror)` sideways (to
+/// first order), against the exact reflection off that facet; the slopes
+/// across spread with Cox and Munk's deviation in one direction,
+/// `√(mss / 2)` (0.15 at 7 m/s). Until 2026-12-04 the reflected rays kept
+/// the view's azimuth, and a mirrored cloud's streak had the cloud's
+/// sharp sides all the way down.
+#[test]
+fn the_waves_turn_the_reflected_rays_sideways() {
+    let n = 20_000;
+    let wind = 7.0_f32;
+    let s: Vec<f32> = (0..n)
+        .map(|i| cross_slope(wind, (i as f32 + 0.5) / n as f32))
+        .collect();
+    let mean = s.iter().sum::<f32>() / n as f32;
+    let sd = (s.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / n as f32).sqrt();
+    let deviation = (0.5 * (0.003 + 0.00512 * wind)).sqrt();
+    assert!(mean.abs() < 1e-3, "{mean}");
+    assert!((sd / deviation - 1.0).abs() < 0.03, "{sd} vs {deviation}");
+    // The reflection off a facet of slope `cross` across and none along.
+    let across = Vec3::new(0.6, 0.0, 0.8);
+    let side = Vec3::new(-across.z, 0.0, across.x);
+    for mirror_deg in [2.0_f32, 10.0, 40.0] {
+        let m = mirror_deg.to_radians();
+        let dir = across * m.cos() - Vec3::Y * m.sin();
+        let cross = 0.02;
+        let normal = (Vec3::Y + side * cross).normalize();
+        let exact = dir - normal * (2.0 * dir.dot(normal));
+        let r = reflected_ray(across, m, m, cross);
+        assert!((r.length() - 1.0).abs() < 1e-5);
+        let (sideways, exact_sideways) = (r.dot(side), exact.dot(side));
+        assert!(
+            (sideways - exact_sideways).abs() < 0.05 * exact_sideways.abs(),
+            "mirror {mirror_deg}°: sideways {sideways} vs {exact_sideways}"
+        );
+        assert!(
+            (r - exact).length() < 1e-3,
+            "mirror {mirror_deg}°: {r} vs {exact}"
+        );
+        assert!(r.dot(side) > 0.0 && exact.dot(side) > 0.0);
+        // No slope across: the ray keeps the view's azimuth.
+        assert!(reflected_ray(across, m, m, 0.0).dot(side).abs() < 1e-6);
     }
 }
 
