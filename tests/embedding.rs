@@ -355,13 +355,18 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
     // whose rays through the detail noise the two twins round
     // differently (measured on lavapipe: 21 of 18,432 channels, at most
     // 5 levels, once the land was lit by the sun with its full contrast
-    // between sun and shade).
+    // between sun and shade). Over the sea, for a few more where the 12
+    // reflected rays, turned sideways by the waves, graze the mirrored
+    // clouds' edges (measured on lavapipe, 2026-12-04: 53 channels, all
+    // below the horizon, 25 brighter on the CPU and 28 on the GPU, at
+    // most 7 levels; the mean difference 0.02 levels).
+    let share = if name == "bomex" { 0.004 } else { 0.002 };
     assert!(
-        off as f64 <= 0.002 * ours.len() as f64,
+        off as f64 <= share * ours.len() as f64,
         "{off} channels differ by more than 2 levels"
     );
-    // Over the sea, each pixel's 6 reflected rays take 4 steps each
-    // across kilometres of band; where one of them grazes a cloud's edge
+    // Over the sea, each pixel's 12 reflected rays take 4 to 16 steps
+    // each across kilometres of band; where one of them grazes a cloud's edge
     // the twins can disagree on it, as the parity tests allow on single
     // pixels (measured on lavapipe: one BOMEX pixel, 22 levels).
     let allowed = if name == "bomex" { 64 } else { 8 };
