@@ -75,8 +75,10 @@ const GROUND_LIGHT_GAIN: f32 = 4.18;
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
-// The sea's reflection: reflected rays a pixel, the uniform steps of each
-// and their shadow samples, the lowest elevation the waves send one to.
+// The sea's reflection: reflected rays a pixel, the fewest and the most
+// uniform steps of each and the step it takes where it can
+// (reflection_step_count), their shadow samples, the lowest elevation the
+// waves send one to.
 const REFLECTION_RAYS: u32 = 12u;
 const REFLECTION_STEPS: u32 = 4u;
 const REFLECTION_STEPS_MAX: u32 = 16u;
@@ -576,10 +578,11 @@ fn cross_slope(wind_mps: f32, u: f32) -> f32 {
 
 // The ray a wave sends up from the sea, seen along a ray falling at
 // `mirror` radians along `across`: rising at elevation `e`, turned
-// sideways by `2 cross sin(mirror)` (the CPU's `reflected_ray`).
-fn reflected_ray(across: vec3f, mirror: f32, e: f32, cross: f32) -> vec3f {
+// sideways by `2 slope sin((mirror + e) / 2)` (the CPU's `reflected_ray`).
+fn reflected_ray(across: vec3f, mirror: f32, e: f32, slope: f32) -> vec3f {
     let side = vec3f(-across.z, 0.0, across.x);
-    return normalize(across * cos(e) + side * (2.0 * cross * sin(mirror)) + vec3f(0.0, sin(e), 0.0));
+    let sideways = 2.0 * slope * sin(0.5 * (mirror + e));
+    return normalize(across * cos(e) + side * sideways + vec3f(0.0, sin(e), 0.0));
 }
 
 // The sky the flat sea mirrors along `dir` (the CPU's `mirrored_sky`).
@@ -626,8 +629,8 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
     for (var k = 0u; k < REFLECTION_RAYS; k++) {
         let u = (f32(k) + dither) / f32(REFLECTION_RAYS);
         let e = reflected_elevation(mirror, SEA_WIND_MPS, u);
-        let cross = cross_slope(SEA_WIND_MPS, fract((f32(k) + 0.5) * GOLDEN + step_dither));
-        let r = reflected_ray(across, mirror, e, cross);
+        let slope = cross_slope(SEA_WIND_MPS, fract((f32(k) + 0.5) * GOLDEN + step_dither));
+        let r = reflected_ray(across, mirror, e, slope);
         sum += reflected_clouds(p, r, t_sea, step_dither, sun_dir, sun, sky_top, ground, blur);
     }
     return sum / f32(REFLECTION_RAYS);

@@ -583,12 +583,15 @@ fn the_waves_spread_the_reflected_rays_elevation() {
 }
 
 /// The waves turn the reflected ray sideways too: a facet tilted across
-/// the line of sight by `s` sends the ray `2 s sin(mirror)` sideways (to
-/// first order), against the exact reflection off that facet; the slopes
-/// across spread with Cox and Munk's deviation in one direction,
-/// `√(mss / 2)` (0.15 at 7 m/s). Until 2026-12-04 the reflected rays kept
-/// the view's azimuth, and a mirrored cloud's streak had the cloud's
-/// sharp sides all the way down.
+/// the line of sight by `s` sends the ray `2 s sin((mirror + e) / 2)`
+/// sideways (to first order), against the exact reflection off a facet
+/// tilted toward the viewer as well (by `α`, which sends the ray up to
+/// `e`); the slopes across spread with Cox and Munk's deviation in one
+/// direction, `√(mss / 2)` (0.14 at 7 m/s). Until 2026-12-04 the
+/// reflected rays kept the view's azimuth, and a mirrored cloud's streak
+/// had the cloud's sharp sides all the way down; `2 s sin(mirror)`,
+/// without the facet's tilt toward the viewer, turned the steep rays
+/// near the horizon a fifth as far as they go (0.6° for 2.8°).
 #[test]
 fn the_waves_turn_the_reflected_rays_sideways() {
     let n = 20_000;
@@ -601,29 +604,32 @@ fn the_waves_turn_the_reflected_rays_sideways() {
     let deviation = (0.5 * (0.003 + 0.00512 * wind)).sqrt();
     assert!(mean.abs() < 1e-3, "{mean}");
     assert!((sd / deviation - 1.0).abs() < 0.03, "{sd} vs {deviation}");
-    // The reflection off a facet of slope `cross` across and none along.
+    // The reflection off a facet of slope `slope` across and `alpha`
+    // toward the viewer.
     let across = Vec3::new(0.6, 0.0, 0.8);
     let side = Vec3::new(-across.z, 0.0, across.x);
     for mirror_deg in [2.0_f32, 10.0, 40.0] {
-        let m = mirror_deg.to_radians();
-        let dir = across * m.cos() - Vec3::Y * m.sin();
-        let cross = 0.02;
-        let normal = (Vec3::Y + side * cross).normalize();
-        let exact = dir - normal * (2.0 * dir.dot(normal));
-        let r = reflected_ray(across, m, m, cross);
-        assert!((r.length() - 1.0).abs() < 1e-5);
-        let (sideways, exact_sideways) = (r.dot(side), exact.dot(side));
-        assert!(
-            (sideways - exact_sideways).abs() < 0.05 * exact_sideways.abs(),
-            "mirror {mirror_deg}°: sideways {sideways} vs {exact_sideways}"
-        );
-        assert!(
-            (r - exact).length() < 1e-3,
-            "mirror {mirror_deg}°: {r} vs {exact}"
-        );
-        assert!(r.dot(side) > 0.0 && exact.dot(side) > 0.0);
-        // No slope across: the ray keeps the view's azimuth.
-        assert!(reflected_ray(across, m, m, 0.0).dot(side).abs() < 1e-6);
+        for alpha in [0.0_f32, 0.07, 0.14] {
+            let m = mirror_deg.to_radians();
+            let dir = across * m.cos() - Vec3::Y * m.sin();
+            let slope = 0.02;
+            let normal = (Vec3::Y - across * alpha + side * slope).normalize();
+            let exact = dir - normal * (2.0 * dir.dot(normal));
+            let e = exact.y.asin();
+            let r = reflected_ray(across, m, e, slope);
+            assert!((r.length() - 1.0).abs() < 1e-5);
+            let (sideways, exact_sideways) = (r.dot(side), exact.dot(side));
+            assert!(
+                exact_sideways > 0.0 && (sideways - exact_sideways).abs() < 0.05 * exact_sideways,
+                "mirror {mirror_deg}°, alpha {alpha}: sideways {sideways} vs {exact_sideways}"
+            );
+            assert!(
+                (r - exact).length() < 1e-3,
+                "mirror {mirror_deg}°, alpha {alpha}: {r} vs {exact}"
+            );
+            // No slope across: the ray keeps the view's azimuth.
+            assert!(reflected_ray(across, m, e, 0.0).dot(side).abs() < 1e-6);
+        }
     }
 }
 

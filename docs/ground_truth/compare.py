@@ -356,8 +356,9 @@ def main():
                     # Written whole, then renamed: an interrupted run
                     # leaves no half-written entry for the next to read.
                     os.makedirs(a.cache, exist_ok=True)
-                    np.save(cached + ".tmp.npy", truth)
-                    os.replace(cached + ".tmp.npy", cached)
+                    part = f"{cached}.{os.getpid()}.tmp.npy"
+                    np.save(part, truth)
+                    os.replace(part, cached)
             cloud, tau, near_sun = cloud_pixels(name, vol, side, a.width, a.height)
             yo, ym = luminance(ours), luminance(truth)
             rel = (yo - ym) / np.maximum(ym, 1e-6)

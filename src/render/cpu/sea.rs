@@ -66,8 +66,7 @@ pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
 ///
 /// A facet tilted by a slope `s` toward or away from the viewer turns
 /// the reflected ray up or down by `2 s` (sideways tilts turn it in
-/// azimuth, by far less at the grazing angles where a sea's reflection
-/// shows). Cox and Munk's (1954) mean square slope `0.003 + 0.00512 U`
+/// azimuth: [`cross_slope`], [`reflected_ray`]). Cox and Munk's (1954) mean square slope `0.003 + 0.00512 U`
 /// for a wind of `U` m/s is split between the two directions, so the
 /// elevation spreads with a standard deviation of `√(2 · that)`: 0.28 rad
 /// (16°) at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
@@ -87,7 +86,7 @@ pub fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
 
 /// A wave's slope across the line of sight at the quantile `u` in `(0,
 /// 1)`, in a wind of `wind_mps`: a logistic of Cox and Munk's deviation
-/// in one direction, `√((0.003 + 0.00512 U) / 2)` (0.15 at 7 m/s), as
+/// in one direction, `√((0.003 + 0.00512 U) / 2)` (0.14 at 7 m/s), as
 /// [`reflected_elevation`]'s slopes along it.
 #[inline]
 pub fn cross_slope(wind_mps: f32, u: f32) -> f32 {
@@ -100,16 +99,19 @@ pub fn cross_slope(wind_mps: f32, u: f32) -> f32 {
 /// The ray a wave sends up from the sea, seen along a ray that falls at
 /// `mirror` radians, horizontally along `across` (unit): rising at
 /// elevation `e` ([`reflected_elevation`]) and turned sideways by the
-/// wave's slope `cross` across the line of sight ([`cross_slope`]). A
-/// facet tilted sideways by `s` adds `2 s sin(mirror)` of the ray's
-/// length sideways (to first order): little at the grazing angles near
-/// the horizon, up to `2 s` looking straight down. A mirrored cloud's
-/// streak is as wide as the cloud, its edges softened by it (by about
-/// 3° of azimuth 10° below the horizon at 7 m/s).
+/// wave's slope `slope` across the line of sight ([`cross_slope`]). A
+/// facet tilted sideways by `s` adds `2 s sin((mirror + e) / 2)` of the
+/// ray's length sideways (to first order in `s`; the view ray meets the
+/// facet at `(mirror + e) / 2`, the facet's tilt toward the viewer
+/// included): up to `2 s` looking straight down, and near the horizon
+/// still some degrees for the steep rays that reach the clouds (2.8° at
+/// `s` 0.14, a mirror ray 2° down and a reflected ray 17.6° up). A
+/// mirrored cloud's streak is as wide as the cloud, its sides softened.
 #[inline]
-pub fn reflected_ray(across: Vec3, mirror: f32, e: f32, cross: f32) -> Vec3 {
+pub fn reflected_ray(across: Vec3, mirror: f32, e: f32, slope: f32) -> Vec3 {
     let side = Vec3::new(-across.z, 0.0, across.x);
-    (across * e.cos() + side * (2.0 * cross * mirror.sin()) + Vec3::Y * e.sin()).normalize()
+    let sideways = 2.0 * slope * (0.5 * (mirror + e)).sin();
+    (across * e.cos() + side * sideways + Vec3::Y * e.sin()).normalize()
 }
 
 /// The clouds mirrored by the sea where a ray that meets no terrain
@@ -156,8 +158,8 @@ pub fn sea_reflection(
         let e = reflected_elevation(mirror, wind, u);
         // The sideways slopes in golden-ratio steps, apart from the
         // elevation's strata.
-        let cross = cross_slope(wind, ((k as f32 + 0.5) * GOLDEN + step_dither).fract());
-        let r = reflected_ray(across, mirror, e, cross);
+        let slope = cross_slope(wind, ((k as f32 + 0.5) * GOLDEN + step_dither).fract());
+        let r = reflected_ray(across, mirror, e, slope);
         let (l, t) = reflected_clouds(p, r, t_sea, step_dither, sun_dir, &light_in, spread, fr);
         light += l;
         transmittance += t;
@@ -233,7 +235,7 @@ pub fn sea_reflection_change(
 /// The clouds along one ray `r` the sea reflects from `p`, `t_sea` from
 /// the eye: (their light, premultiplied; the ray's transmittance through
 /// the band). The ray is marched across the band in
-/// [`REFLECTION_STEPS`] uniform steps, each sample placed in its step by
+/// [`reflection_step_count`] uniform steps (about 300 m, 4 to 16), each sample placed in its step by
 /// `dither` (fine grain, not bands of rows that sample the same depths),
 /// each lit sample by the sun through [`cloud_shadow`] with
 /// [`REFLECTION_SHADOW_STEPS`] samples (the octaves as in the clouds' own
@@ -241,11 +243,9 @@ pub fn sea_reflection_change(
 /// twin of [`march_ray`], for a reflection the Fresnel factor dims to a
 /// few percent looking down. The clouds are read at the level of detail
 /// of twice the Cox-Munk slopes' deviation times the distance
-/// (`light_in.blur`), so that 4 samples across the band do not alias.
-/// That blurs sideways too, more than the waves do at the grazing angles
-/// where reflections show (a sideways tilt `s` turns the ray by about
-/// `2 s tan(elevation)` in azimuth): a choice against aliasing, not the
-/// waves' own blur.
+/// (`light_in.blur`), so that a few samples across the band do not
+/// alias. That blurs sideways too, beside the waves' own sideways turn
+/// ([`reflected_ray`]): a choice against aliasing.
 #[allow(clippy::too_many_arguments)]
 pub fn reflected_clouds(
     p: Vec3,
