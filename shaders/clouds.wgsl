@@ -75,8 +75,8 @@ const GROUND_LIGHT_GAIN: f32 = 4.18;
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
 const GROUND_SHADOW_STEPS: u32 = 12u;
-// The sea's reflection: reflected rays a pixel, the fewest and the most
-// uniform steps of each and the step it takes where it can
+// The sea's reflection: reflected rays a pixel, the fewest and most
+// uniform steps of each and the step length it takes where it can
 // (reflection_step_count), their shadow samples, the lowest elevation the
 // waves send one to.
 const REFLECTION_RAYS: u32 = 12u;
@@ -470,19 +470,21 @@ struct Aerial {
 // sky_physical.wgsl) defines sun_light_at, sky_above, aerial, ground_haze
 // and sun_disk, the twins of src/render/cpu/sky.rs.
 
-// The flat land's own light (the CPU's `land_surface`; the albedo is its
-// LAND_ALBEDO).
+// The flat land's albedo (the CPU's sky.rs).
+const LAND_ALBEDO: vec3f = vec3f(0.08, 0.1, 0.06);
+
+// The flat land's own light (the CPU's `land_surface`).
 fn land_surface(sun_dir: vec3f, shadow: f32) -> vec3f {
     let sun = sun_light_at(0.0, sun_dir);
     let lit = sun * (max(sun_dir.y, 0.0) * shadow / PI) + sky_ambient(sun_dir);
-    return vec3f(0.08, 0.1, 0.06) * lit;
+    return LAND_ALBEDO * lit;
 }
 
 // The flat land through the air, its sunlit part dimmed by the clouds'
 // shadow, with the sunlight the clouds scatter down onto it (the CPU's
 // `land_radiance`).
 fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
-    let surface = land_surface(sun_dir, shadow) + vec3f(0.08, 0.1, 0.06) * ground_cloud_light(sun_dir);
+    let surface = land_surface(sun_dir, shadow) + LAND_ALBEDO * ground_cloud_light(sun_dir);
     return ground_haze(surface, dir, sun_dir);
 }
 
@@ -578,10 +580,10 @@ fn cross_slope(wind_mps: f32, u: f32) -> f32 {
 
 // The ray a wave sends up from the sea, seen along a ray falling at
 // `mirror` radians along `across`: rising at elevation `e`, turned
-// sideways by `2 slope sin((mirror + e) / 2)` (the CPU's `reflected_ray`).
+// sideways by `slope (sin(mirror) + sin(e))` (the CPU's `reflected_ray`).
 fn reflected_ray(across: vec3f, mirror: f32, e: f32, slope: f32) -> vec3f {
     let side = vec3f(-across.z, 0.0, across.x);
-    let sideways = 2.0 * slope * sin(0.5 * (mirror + e));
+    let sideways = slope * (sin(mirror) + sin(e));
     return normalize(across * cos(e) + side * sideways + vec3f(0.0, sin(e), 0.0));
 }
 

@@ -37,10 +37,15 @@ fn normal_at(x: f32, z: f32) -> vec3f {
     return normalize(vec3f(-dx, 2.0 * e, -dz));
 }
 
+// The terrain's albedo flat and from a slope of a third (the CPU's
+// renderer.rs).
+const TERRAIN_ALBEDO_FLAT: vec3f = vec3f(0.07, 0.11, 0.04);
+const TERRAIN_ALBEDO_STEEP: vec3f = vec3f(0.16, 0.13, 0.09);
+
 fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let n = normal_at(p.x, p.z);
     let slope = 1.0 - n.y;
-    let albedo = mix(vec3f(0.07, 0.11, 0.04), vec3f(0.16, 0.13, 0.09), min(slope * 3.0, 1.0));
+    let albedo = mix(TERRAIN_ALBEDO_FLAT, TERRAIN_ALBEDO_STEEP, min(slope * 3.0, 1.0));
     var shadow = 1.0;
     if SHADOW_STEPS > 0u && sun_dir.y > 0.0 {
         shadow = cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);

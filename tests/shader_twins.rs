@@ -253,6 +253,22 @@ fn every_wgsl_constant_equals_its_rust_twin() {
                 naga::Expression::Literal(naga::Literal::F32(v)) => v as f64,
                 naga::Expression::Literal(naga::Literal::U32(v)) => v as f64,
                 naga::Expression::Literal(naga::Literal::I32(v)) => v as f64,
+                naga::Expression::Compose { ref components, .. } => {
+                    let wgsl: Vec<f32> = components
+                        .iter()
+                        .map(|&h| match m.global_expressions[h] {
+                            naga::Expression::Literal(naga::Literal::F32(v)) => v,
+                            ref e => panic!("WGSL const {name}: a component is {e:?}"),
+                        })
+                        .collect();
+                    let Some((_, twin)) = rust_vectors().into_iter().find(|(n, _)| n == name)
+                    else {
+                        panic!("WGSL const {name} has no Rust twin in rust_vectors()");
+                    };
+                    assert_eq!(wgsl, twin.to_array(), "const {name}");
+                    seen.insert(name.clone());
+                    continue;
+                }
                 ref e => panic!("WGSL const {name} is not a plain literal: {e:?}"),
             };
             let Some((_, twin)) = rust.iter().find(|(n, _)| n == name) else {
@@ -262,9 +278,22 @@ fn every_wgsl_constant_equals_its_rust_twin() {
             seen.insert(name.clone());
         }
     }
-    for (name, _) in rust {
+    for name in rust
+        .iter()
+        .map(|c| c.0)
+        .chain(rust_vectors().iter().map(|c| c.0))
+    {
         assert!(seen.contains(name), "no WGSL const {name}");
     }
+}
+
+/// The Rust twins of the WGSL `vec3f` constants.
+fn rust_vectors() -> Vec<(&'static str, glam::Vec3)> {
+    vec![
+        ("LAND_ALBEDO", sky::LAND_ALBEDO),
+        ("TERRAIN_ALBEDO_FLAT", renderer::TERRAIN_ALBEDO_FLAT),
+        ("TERRAIN_ALBEDO_STEEP", renderer::TERRAIN_ALBEDO_STEEP),
+    ]
 }
 
 /// The members of the WGSL struct `name` as (member, byte offset).

@@ -323,6 +323,13 @@ pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
     }
 }
 
+/// The terrain's albedo where it is flat (grass) and where its slope,
+/// `1 - n.y`, is a third or more (bare rock and soil), linear between
+/// (`TERRAIN_ALBEDO_FLAT` and `TERRAIN_ALBEDO_STEEP` in
+/// `shaders/terrain.wgsl`).
+pub const TERRAIN_ALBEDO_FLAT: Vec3 = Vec3::new(0.07, 0.11, 0.04);
+pub const TERRAIN_ALBEDO_STEEP: Vec3 = Vec3::new(0.16, 0.13, 0.09);
+
 /// Radiance of the terrain at `p` (distance `t` along `dir`): lit by the
 /// sun through the clouds (their shadow, when shadows are on), the sky
 /// and the sunlight the clouds scatter down (`ground_cloud_light`), faded
@@ -338,8 +345,7 @@ pub fn terrain_radiance(
     let d = &fr.density;
     let n = h.normal_at(p.x, p.z);
     let slope = 1.0 - n.y;
-    let albedo =
-        Vec3::new(0.07, 0.11, 0.04).lerp(Vec3::new(0.16, 0.13, 0.09), (slope * 3.0).min(1.0));
+    let albedo = TERRAIN_ALBEDO_FLAT.lerp(TERRAIN_ALBEDO_STEEP, (slope * 3.0).min(1.0));
     let shadow = if fr.quality.shadow_steps > 0 && sun_dir.y > 0.0 {
         cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS, &fr.fields, d)
     } else {

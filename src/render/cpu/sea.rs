@@ -100,17 +100,17 @@ pub fn cross_slope(wind_mps: f32, u: f32) -> f32 {
 /// `mirror` radians, horizontally along `across` (unit): rising at
 /// elevation `e` ([`reflected_elevation`]) and turned sideways by the
 /// wave's slope `slope` across the line of sight ([`cross_slope`]). A
-/// facet tilted sideways by `s` adds `2 s sin((mirror + e) / 2)` of the
-/// ray's length sideways (to first order in `s`; the view ray meets the
-/// facet at `(mirror + e) / 2`, the facet's tilt toward the viewer
-/// included): up to `2 s` looking straight down, and near the horizon
-/// still some degrees for the steep rays that reach the clouds (2.8° at
-/// `s` 0.14, a mirror ray 2° down and a reflected ray 17.6° up). A
-/// mirrored cloud's streak is as wide as the cloud, its sides softened.
+/// facet tilted sideways by `s` adds `s (sin(mirror) + sin(e))` of the
+/// ray's length sideways (to first order in `s`, whatever the facet's
+/// tilt toward the viewer that sends the ray to `e`): up to `2 s`
+/// looking straight down, and near the horizon still some degrees for
+/// the steep rays that reach the clouds (2.8° at `s` 0.14, a mirror ray
+/// 2° down and a reflected ray 17.6° up). A mirrored cloud's streak is
+/// as wide as the cloud, its sides softened.
 #[inline]
 pub fn reflected_ray(across: Vec3, mirror: f32, e: f32, slope: f32) -> Vec3 {
     let side = Vec3::new(-across.z, 0.0, across.x);
-    let sideways = 2.0 * slope * (0.5 * (mirror + e)).sin();
+    let sideways = slope * (mirror.sin() + e.sin());
     (across * e.cos() + side * sideways + Vec3::Y * e.sin()).normalize()
 }
 
