@@ -53,6 +53,7 @@ pub fn reflection_step_count(length: f32) -> u32 {
     ((length / REFLECTION_STEP_M).ceil().max(0.0) as u32)
         .clamp(REFLECTION_STEPS, REFLECTION_STEPS_MAX)
 }
+
 /// Samples of each of its steps' shadow rays (`REFLECTION_SHADOW_STEPS`).
 pub const REFLECTION_SHADOW_STEPS: u32 = 2;
 /// The lowest elevation (radians, about 0.6°) a wave sends a reflected
@@ -66,8 +67,9 @@ pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
 ///
 /// A facet tilted by a slope `s` toward or away from the viewer turns
 /// the reflected ray up or down by `2 s` (sideways tilts turn it in
-/// azimuth: [`cross_slope`], [`reflected_ray`]). Cox and Munk's (1954) mean square slope `0.003 + 0.00512 U`
-/// for a wind of `U` m/s is split between the two directions, so the
+/// azimuth: [`cross_slope`], [`reflected_ray`]). Cox and Munk's (1954)
+/// mean square slope `0.003 + 0.00512 U` for a wind of `U` m/s is split
+/// between the two directions, so the
 /// elevation spreads with a standard deviation of `√(2 · that)`: 0.28 rad
 /// (16°) at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
 /// distribution of that deviation (its quantile in closed form; its
