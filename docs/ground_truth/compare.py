@@ -207,6 +207,16 @@ def read_vol(path):
     return np.frombuffer(raw[48:], "<f4").reshape(nz, ny, nx)
 
 
+def save_cached(path, array):
+    """Writes a cache entry (the `--cache` renders, and the other scripts'
+    beside them) whole, then renames it into place: an interrupted run
+    leaves no half-written entry for the next to read. Makes the folder."""
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    part = f"{path}.{os.getpid()}.tmp.npy"
+    np.save(part, array)
+    os.replace(part, path)
+
+
 def cache_key(name, width, height, spp, cells, suffix=""):
     """The file name a Mitsuba render of view `name` is cached under
     (`--cache`; noise_floor.py, surrogate.py and ground_shadow.py use
@@ -353,12 +363,7 @@ def main():
             else:
                 truth = mitsuba_render(vol, sky, side, a.spp, a.width, a.height, a.single_scattering)
                 if cached:
-                    # Written whole, then renamed: an interrupted run
-                    # leaves no half-written entry for the next to read.
-                    os.makedirs(a.cache, exist_ok=True)
-                    part = f"{cached}.{os.getpid()}.tmp.npy"
-                    np.save(part, truth)
-                    os.replace(part, cached)
+                    save_cached(cached, truth)
             cloud, tau, near_sun = cloud_pixels(name, vol, side, a.width, a.height)
             yo, ym = luminance(ours), luminance(truth)
             rel = (yo - ym) / np.maximum(ym, 1e-6)

@@ -64,8 +64,7 @@ def cached_render(a, binary, name, extra, tmp):
     path = os.path.join(a.cache, f"{name}_{os.path.basename(binary)}_{st.st_size}_{int(st.st_mtime)}_"
                                  f"{a.width}x{a.height}x{a.supersample}_{keys}.npy")
     if not os.path.exists(path):
-        os.makedirs(a.cache, exist_ok=True)
-        np.save(path, render(binary, name, a.width, a.height, a.supersample, extra, tmp))
+        C.save_cached(path, render(binary, name, a.width, a.height, a.supersample, extra, tmp))
     return np.load(path)
 
 

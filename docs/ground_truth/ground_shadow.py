@@ -97,8 +97,7 @@ def main():
                 mi_img = compare.mitsuba_render(vol, sky, side, a.spp, a.width, a.height,
                                                 ground=LAND_ALBEDO)
                 if cached:
-                    os.makedirs(a.cache, exist_ok=True)
-                    np.save(cached, mi_img)
+                    compare.save_cached(cached, mi_img)
             eye, dirs = compare.camera_rays(side, a.width, a.height)
             tau = sun_depth(compare.read_vol(vol), side, eye, dirs)
             y_ours, y_mi = compare.luminance(ours), compare.luminance(mi_img)

@@ -90,7 +90,7 @@ def main():
                 renders.append(C.mitsuba_render(vol, sky, side, a.spp, a.width, a.height))
                 mi.render = render
                 if cached and offset:
-                    np.save(cached, renders[-1])
+                    C.save_cached(cached, renders[-1])
             cloud = C.cloud_pixels(name, vol, side, a.width, a.height)[0]
             y1, y2 = C.luminance(renders[1]), C.luminance(renders[0])
             rel = (y1 - y2) / np.maximum(y2, 1e-6)

@@ -321,8 +321,8 @@ def main():
                 sun_ref = os.path.join(a.cache, f"{name}_{a.width}x{a.height}_{a.decompose}spp_"
                                                 f"{a.cells}cells_sun.npy")
                 if not os.path.exists(sun_ref):
-                    np.save(sun_ref, C.mitsuba_render(vol, sky_path, side, a.decompose,
-                                                      a.width, a.height, sky=False))
+                    C.save_cached(sun_ref, C.mitsuba_render(vol, sky_path, side, a.decompose,
+                                                            a.width, a.height, sky=False))
                 s["truth_sun"] = (np.load(sun_ref) @ Y).reshape(-1)
             bg, up, up_cos, down = sky_terms(side, sky_path, a.width, a.height)
             lo, hi = side["box_min_m"][1], side["box_max_m"][1]
