@@ -332,6 +332,8 @@ def main():
     views = [v for v in VIEWS if v[0] in a.views.split(",")]
     if not views:
         sys.exit(f"--views {a.views}: none of {', '.join(v[0] for v in VIEWS)}")
+    # Made before the renders, not found missing after them.
+    os.makedirs(a.out, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, base, sun_el, sun_az, yaw in views:
