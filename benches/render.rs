@@ -1,5 +1,5 @@
-//! Cloud-map generation, the light volume's build and its three steps,
-//! and CPU rendering of a 320x240 frame.
+//! Cloud-map generation, P's spread, the light volume's build and its
+//! three steps, and CPU rendering of a 320x240 frame.
 //!
 //! `cargo bench --bench render`
 
@@ -11,6 +11,7 @@ use cumulus::render::cpu::light_volume::{
 };
 use cumulus::render::cpu::renderer::render_linear;
 use cumulus::render::cpu::sky::sun_direction;
+use cumulus::render::soft_field::{SPREAD_M, soft_field};
 use cumulus::scene::Scene;
 
 fn render(c: &mut Criterion) {
@@ -20,6 +21,22 @@ fn render(c: &mut Criterion) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/fair_weather.toml");
     let scene = Scene::load(&path).expect("shipped scene");
     let prepared = Prepared::from_scene(&scene, || {}).expect("prepares");
+    // P's spread, done on every upload of P: at the scene's extent and at
+    // the extent of `cumulus bench`'s 12-parcel sky (sqrt(12/160) of it),
+    // where the kernel spans more texels.
+    let extent = prepared.map_extent_m as f32;
+    c.bench_function("soft_field_fair_weather", |b| {
+        b.iter(|| soft_field(&prepared.field, SPREAD_M, extent))
+    });
+    c.bench_function("soft_field_12_parcels", |b| {
+        b.iter(|| {
+            soft_field(
+                &prepared.field,
+                SPREAD_M,
+                extent * (12.0_f32 / 160.0).sqrt(),
+            )
+        })
+    });
     let r = &scene.render;
     let frame = prepared.frame(r, r.quality());
     let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
