@@ -21,10 +21,24 @@ Mitsuba's multiply scattered light to ours by the view's optical depth;
 and the per-pixel error once our multiply scattered light is corrected
 by the ratio smoothed over the cloud pixels with a Gaussian of sigma
 pixels (how large the error's structures are).
+
+With --geometry it also exports the view's volume (256 cells, the same
+scene as compare.py's) and finds, for each pixel, where the view ray's
+optical depth through the grid reaches 1, the optical depth from there
+toward the sun, and the ray's angle to the sun. It prints the ratio by
+that sun depth, and a bound: the per-pixel error after our multiply
+scattered light is scaled, bin by bin, by the best factor for that bin
+(a grid search against Mitsuba), for bins of the view's optical depth,
+of the sun depth, of the angle, and of all three together. A light
+model whose error is a function of those variables alone can do no
+better than that bound.
 """
 
 import argparse
+import json
 import os
+import sys
+import tempfile
 
 import numpy as np
 from scipy.ndimage import gaussian_filter
@@ -37,6 +51,12 @@ def main():
     ap.add_argument("full", help="compare.py --arrays output, the full light")
     ap.add_argument("single", help="compare.py --single-scattering --arrays output")
     ap.add_argument("--view", default="backlit")
+    ap.add_argument("--geometry", action="store_true",
+                    help="bin by the sun's optical depth from the first hit and the angle "
+                         "to the sun, and print the best-scale bound per bin")
+    ap.add_argument("--bin", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                                  "..", "..", "target", "release", "cumulus"),
+                    help="the cumulus binary that exports the volume (--geometry)")
     ap.add_argument("--second", default=None,
                     help="a second Mitsuba render of the full light (.npy), averaged "
                          "with the first")
@@ -70,6 +90,78 @@ def main():
     for sigma in [1, 2, 3, 5, 8, 12]:
         k = gaussian_filter(tm * c, sigma) / np.maximum(gaussian_filter(om * c, sigma), 1e-9)
         print(f"    sigma {sigma:2d}: {err(os_ + om * k):.4f}")
+    if a.geometry:
+        sun_tau, angle = view_geometry(a.view, a.bin, t.shape)
+        print("  the rest, Mitsuba's over ours, by the sun's optical depth from where the "
+              "view's reaches 1:")
+        for lo, hi in [(0, 2), (2, 5), (5, 10), (10, 20), (20, np.inf)]:
+            m = cloud & (sun_tau >= lo) & (sun_tau < hi)
+            if m.any():
+                print(f"    sun tau {lo}-{hi}: {tm[m].sum() / om[m].sum():.3f} "
+                      f"({int(m.sum())} pixels)")
+        bins = {
+            "view tau": np.digitize(tau, [3, 6, 12]),
+            "sun tau": np.digitize(sun_tau, [2, 5, 10, 20]),
+            "angle to the sun": np.digitize(angle, [10, 20, 30]),
+        }
+        bins["all three"] = sum(b * 10 ** i for i, b in enumerate(bins.values()))
+        print("  per-pixel error with the rest scaled by the best factor of each bin:")
+        for name, labels in bins.items():
+            fixed = o.copy()
+            for label in np.unique(labels[cloud]):
+                m = cloud & (labels == label)
+                scales = np.linspace(0.3, 2.5, 111)
+                errors = [np.abs((o[m] + (k - 1) * om[m] - t[m]) / t[m]).mean() for k in scales]
+                fixed[m] = o[m] + (scales[int(np.argmin(errors))] - 1) * om[m]
+            print(f"    {name:17s} ({len(np.unique(labels[cloud])):2d} bins): {err(fixed):.4f}")
+
+
+def view_geometry(view, binary, shape):
+    """For each pixel of compare.py's `view`: the optical depth toward the
+    sun from the point where the view ray's optical depth through the
+    exported grid (256 cells) reaches 1, and the ray's angle to the sun,
+    degrees. Pixels whose ray never reaches 1 get 0."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import compare as C
+
+    name, base, el, az, yaw = next(v for v in C.VIEWS if v[0] == view)
+    height, width = shape
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = os.path.join(C.ROOT, "scenes", f".split_{view}_{os.getpid()}.toml")
+        C.scene_variant(base, el, az, yaw, width, height, scene, C.VIEW_CAMERA.get(view, {}))
+        try:
+            vol_path = os.path.join(tmp, "v.vol")
+            C.run([binary, "export", "--scene", scene, "--out", vol_path, "--cells", "256"])
+        finally:
+            os.remove(scene)
+        side = json.load(open(vol_path[:-4] + ".json"))
+        vol = C.read_vol(vol_path)
+    lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
+    res = np.array(side["resolution"])
+
+    def sigma(p):
+        idx = np.floor((p - lo) / (hi - lo) * res).astype(int)
+        inside = np.all((idx >= 0) & (idx < res), axis=-1)
+        i = np.clip(idx, 0, res - 1)
+        return np.where(inside, vol[i[..., 2], i[..., 1], i[..., 0]], 0.0)
+
+    eye, dirs = C.camera_rays(side, width, height)
+    sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
+    step = 5.0
+    depth, hit = np.zeros(shape), np.full(shape + (3,), np.nan)
+    for t in np.arange(0.0, 20000.0, step):
+        p = eye + dirs * t
+        new = depth + sigma(p) * step
+        first = (depth < 1.0) & (new >= 1.0)
+        hit[first] = p[first]
+        depth = new
+    found = ~np.isnan(hit[..., 0])
+    start = np.where(found[..., None], hit, eye)
+    sun_tau = np.zeros(shape)
+    for t in np.arange(0.0, 12000.0, step):
+        sun_tau += sigma(start + sun * t) * step
+    angle = np.degrees(np.arccos(np.clip(dirs @ sun, -1.0, 1.0)))
+    return np.where(found, sun_tau, 0.0), angle
 
 
 if __name__ == "__main__":
