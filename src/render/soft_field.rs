@@ -77,8 +77,10 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
 
 /// `src` (`w x h`, row-major) convolved with the centred kernel `k` along
 /// rows (`along_x`) or columns, periodically; `k` is at most `w` (rows) or
-/// `h` (columns) long. Rows run in parallel; each texel sums its taps in
-/// the kernel's order, so the result does not depend on the threads.
+/// `h` (columns) long, and `w` and `h` are at least 1 ([`soft_field`]
+/// returns early otherwise). Rows run in parallel; each texel sums its
+/// taps in the kernel's order, so the result does not depend on the
+/// threads.
 fn blur_axis(src: &[[f32; 3]], w: usize, h: usize, k: &[f32], along_x: bool) -> Vec<[f32; 3]> {
     let r = k.len() / 2;
     let mut out = vec![[0.0_f32; 3]; w * h];
@@ -113,67 +115,116 @@ fn blur_axis(src: &[[f32; 3]], w: usize, h: usize, k: &[f32], along_x: bool) -> 
 mod tests {
     use super::*;
 
-    /// The separable, parallel blur against a direct periodic 2D sum, on a
-    /// field neither square nor smooth, with kernels of different lengths
-    /// along x and y (a swapped axis or an off-by-one wrap shows here).
-    #[test]
-    fn the_spread_equals_a_direct_periodic_convolution() {
-        let (w, h, extent, sigma) = (24_usize, 10_usize, 2400.0_f32, 230.0_f32);
-        let mut seed = 7_u32;
+    /// A field of `w x h` random texels, some of them clear.
+    fn random_texels(w: usize, h: usize, mut seed: u32) -> Vec<[f32; 3]> {
         let mut rnd = || {
             seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
             (seed >> 8) as f32 / (1 << 24) as f32
         };
-        let texels: Vec<[f32; 3]> = (0..w * h)
+        (0..w * h)
             .map(|_| {
                 let c = if rnd() < 0.4 { rnd() } else { 0.0 };
                 [c, rnd(), rnd()]
             })
-            .collect();
-        let p = ProjectedField::from_texels(w, h, texels.clone()).expect("size");
-        let got = soft_field(&p, sigma, extent);
-        let kernel = |n: usize| -> Vec<f32> {
-            let s = sigma / (extent / n as f32);
-            let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
-            let k: Vec<f32> = (-r..=r)
-                .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
-                .collect();
-            let sum: f32 = k.iter().sum();
-            k.into_iter().map(|x| x / sum).collect()
-        };
-        let (kx, ky) = (kernel(w), kernel(h));
-        assert!(kx.len() > ky.len(), "the axes get different kernels");
-        let (rx, ry) = ((kx.len() / 2) as i64, (ky.len() / 2) as i64);
-        for y in 0..h {
-            for x in 0..w {
-                let mut a = [0.0_f64; 3];
-                for (j, vy) in ky.iter().enumerate() {
-                    for (i, vx) in kx.iter().enumerate() {
-                        let sx = (x as i64 + i as i64 - rx).rem_euclid(w as i64) as usize;
-                        let sy = (y as i64 + j as i64 - ry).rem_euclid(h as i64) as usize;
-                        let t = texels[sy * w + sx];
-                        let wgt = f64::from(vx * vy);
-                        a[0] += wgt * f64::from(t[0]);
-                        a[1] += wgt * f64::from(t[0] * t[1]);
-                        a[2] += wgt * f64::from(t[0] * t[2]);
+            .collect()
+    }
+
+    /// The separable, parallel blur against a direct periodic 2D sum, on
+    /// fields neither square nor smooth, with kernels of different lengths
+    /// along x and y (a swapped axis or an off-by-one wrap shows here); the
+    /// second case's kernels are cut to the field's size on both axes.
+    #[test]
+    fn the_spread_equals_a_direct_periodic_convolution() {
+        for (w, h, extent, sigma) in [
+            (24_usize, 10_usize, 2400.0_f32, 230.0_f32),
+            (24, 6, 2400.0, 900.0),
+        ] {
+            let texels = random_texels(w, h, 7);
+            let p = ProjectedField::from_texels(w, h, texels.clone()).expect("size");
+            let got = soft_field(&p, sigma, extent);
+            let kernel = |n: usize| -> Vec<f32> {
+                let s = sigma / (extent / n as f32);
+                let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
+                let k: Vec<f32> = (-r..=r)
+                    .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
+                    .collect();
+                let sum: f32 = k.iter().sum();
+                k.into_iter().map(|x| x / sum).collect()
+            };
+            let (kx, ky) = (kernel(w), kernel(h));
+            assert!(kx.len() > ky.len(), "the axes get different kernels");
+            let (rx, ry) = ((kx.len() / 2) as i64, (ky.len() / 2) as i64);
+            for y in 0..h {
+                for x in 0..w {
+                    let mut a = [0.0_f64; 3];
+                    for (j, vy) in ky.iter().enumerate() {
+                        for (i, vx) in kx.iter().enumerate() {
+                            let sx = (x as i64 + i as i64 - rx).rem_euclid(w as i64) as usize;
+                            let sy = (y as i64 + j as i64 - ry).rem_euclid(h as i64) as usize;
+                            let t = texels[sy * w + sx];
+                            let wgt = f64::from(vx * vy);
+                            a[0] += wgt * f64::from(t[0]);
+                            a[1] += wgt * f64::from(t[0] * t[1]);
+                            a[2] += wgt * f64::from(t[0] * t[2]);
+                        }
+                    }
+                    let t = got.at(x, y);
+                    assert!(
+                        (f64::from(t[0]) - a[0].min(1.0)).abs() < 1e-5,
+                        "{w}x{h} ({x},{y}) coverage {t:?} vs {a:?}"
+                    );
+                    if a[0] > 1e-3 {
+                        assert!(
+                            (f64::from(t[1]) - a[1] / a[0]).abs() < 1e-4,
+                            "{w}x{h} ({x},{y}) height"
+                        );
+                        assert!(
+                            (f64::from(t[2]) - a[2] / a[0]).abs() < 1e-4,
+                            "{w}x{h} ({x},{y}) fill"
+                        );
                     }
                 }
-                let t = got.at(x, y);
-                assert!(
-                    (f64::from(t[0]) - a[0].min(1.0)).abs() < 1e-5,
-                    "({x},{y}) coverage {t:?} vs {a:?}"
-                );
-                if a[0] > 1e-3 {
-                    assert!(
-                        (f64::from(t[1]) - a[1] / a[0]).abs() < 1e-4,
-                        "({x},{y}) height"
-                    );
-                    assert!(
-                        (f64::from(t[2]) - a[2] / a[0]).abs() < 1e-4,
-                        "({x},{y}) fill"
-                    );
+            }
+        }
+    }
+
+    /// The parallel blur gives the serial loop's result bit for bit (the
+    /// loop it replaced: one texel at a time, its taps in kernel order,
+    /// wrapped with `rem_euclid`), along both axes, with kernels as long
+    /// as the field allows.
+    #[test]
+    fn the_parallel_blur_is_the_serial_sum_bit_for_bit() {
+        fn serial(src: &[[f32; 3]], w: usize, h: usize, k: &[f32], along_x: bool) -> Vec<[f32; 3]> {
+            let r = (k.len() / 2) as i64;
+            let mut out = vec![[0.0_f32; 3]; w * h];
+            for y in 0..h {
+                for x in 0..w {
+                    let mut s = [0.0_f32; 3];
+                    for (j, kv) in k.iter().enumerate() {
+                        let o = j as i64 - r;
+                        let t = if along_x {
+                            src[y * w + (x as i64 + o).rem_euclid(w as i64) as usize]
+                        } else {
+                            src[(y as i64 + o).rem_euclid(h as i64) as usize * w + x]
+                        };
+                        for c in 0..3 {
+                            s[c] += kv * t[c];
+                        }
+                    }
+                    out[y * w + x] = s;
                 }
             }
+            out
+        }
+        let (w, h) = (24, 7);
+        let src = random_texels(w, h, 11);
+        for (len, along_x) in [(23, true), (9, true), (7, false), (3, false)] {
+            let k: Vec<f32> = (0..len).map(|i| 0.3 + 0.1 * ((i * 7) % 5) as f32).collect();
+            assert_eq!(
+                blur_axis(&src, w, h, &k, along_x),
+                serial(&src, w, h, &k, along_x),
+                "length {len}, along x {along_x}"
+            );
         }
     }
 
