@@ -42,20 +42,8 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
         .iter()
         .map(|t| [t[0], t[0] * t[1], t[0] * t[2]])
         .collect();
-    // Three standard deviations, but never wider than the field itself
-    // (a kernel wider than a period is nearly flat there anyway), so the
-    // cost stays within texels x width.
-    let kernel = |texel_m: f32, n: usize| -> Vec<f32> {
-        let s = (sigma_m / texel_m).max(1e-3);
-        let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
-        let k: Vec<f32> = (-r..=r)
-            .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
-            .collect();
-        let sum: f32 = k.iter().sum();
-        k.into_iter().map(|x| x / sum).collect()
-    };
-    let kx = kernel(extent_m / w as f32, w);
-    let ky = kernel(extent_m / h as f32, h);
+    let kx = gaussian_kernel(sigma_m, extent_m / w as f32, w);
+    let ky = gaussian_kernel(sigma_m, extent_m / h as f32, h);
     let b = blur_axis(&a, w, h, &kx, true);
     let a = blur_axis(&b, w, h, &ky, false);
     let texels = a
@@ -73,6 +61,20 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
         })
         .collect();
     ProjectedField::from_texels(w, h, texels).unwrap_or_else(|| p.clone())
+}
+
+/// The normalised Gaussian of `sigma_m` sampled at texels of `texel_m`
+/// along an axis of `n` texels: three standard deviations each side, but
+/// never wider than the field itself (a kernel wider than a period is
+/// nearly flat there anyway), so the cost stays within texels x width.
+fn gaussian_kernel(sigma_m: f32, texel_m: f32, n: usize) -> Vec<f32> {
+    let s = (sigma_m / texel_m).max(1e-3);
+    let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
+    let k: Vec<f32> = (-r..=r)
+        .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
+        .collect();
+    let sum: f32 = k.iter().sum();
+    k.into_iter().map(|x| x / sum).collect()
 }
 
 /// `src` (`w x h`, row-major) convolved with the centred kernel `k` along
@@ -142,16 +144,8 @@ mod tests {
             let texels = random_texels(w, h, 7);
             let p = ProjectedField::from_texels(w, h, texels.clone()).expect("size");
             let got = soft_field(&p, sigma, extent);
-            let kernel = |n: usize| -> Vec<f32> {
-                let s = sigma / (extent / n as f32);
-                let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
-                let k: Vec<f32> = (-r..=r)
-                    .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
-                    .collect();
-                let sum: f32 = k.iter().sum();
-                k.into_iter().map(|x| x / sum).collect()
-            };
-            let (kx, ky) = (kernel(w), kernel(h));
+            let kx = gaussian_kernel(sigma, extent / w as f32, w);
+            let ky = gaussian_kernel(sigma, extent / h as f32, h);
             assert!(kx.len() > ky.len(), "the axes get different kernels");
             let (rx, ry) = ((kx.len() / 2) as i64, (ky.len() / 2) as i64);
             for y in 0..h {
