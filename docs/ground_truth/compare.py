@@ -166,7 +166,6 @@ def optical_depth(vol, side, eye, dirs, steps=400):
     """Optical depth of each ray through the exported grid (nearest cell,
     uniform steps across the box)."""
     lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
-    res = np.array(side["resolution"])
     with np.errstate(divide="ignore", invalid="ignore"):
         t0 = (lo - eye) / dirs
         t1 = (hi - eye) / dirs
@@ -175,13 +174,20 @@ def optical_depth(vol, side, eye, dirs, steps=400):
     tau = np.zeros(dirs.shape[:2])
     for k in range(steps):
         t = tn + (k + 0.5) / steps * (tf - tn)
-        p = eye + dirs * t[..., None]
-        idx = np.floor((p - lo) / (hi - lo) * res).astype(int)
-        inside = np.all((idx >= 0) & (idx < res), axis=2) & (tf > tn)
-        i = np.clip(idx, 0, res - 1)
-        sigma = vol[i[..., 2], i[..., 1], i[..., 0]]
-        tau += np.where(inside, sigma * (tf - tn) / steps, 0)
+        sigma = grid_extinction(vol, side, eye + dirs * t[..., None])
+        tau += np.where(tf > tn, sigma * (tf - tn) / steps, 0)
     return tau
+
+
+def grid_extinction(vol, side, p):
+    """The exported grid's extinction at points `p` (..., 3), nearest
+    cell; 0 outside the box."""
+    lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
+    res = np.array(side["resolution"])
+    idx = np.floor((p - lo) / (hi - lo) * res).astype(int)
+    inside = np.all((idx >= 0) & (idx < res), axis=-1)
+    i = np.clip(idx, 0, res - 1)
+    return np.where(inside, vol[i[..., 2], i[..., 1], i[..., 0]], 0.0)
 
 
 def cloud_pixels(name, vol_path, side, width, height):

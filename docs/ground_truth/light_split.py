@@ -143,14 +143,8 @@ def view_geometry(view, binary, shape):
             os.remove(scene)
         side = json.load(open(vol_path[:-4] + ".json"))
         vol = C.read_vol(vol_path)
-    lo, hi = np.array(side["box_min_m"]), np.array(side["box_max_m"])
-    res = np.array(side["resolution"])
-
     def sigma(p):
-        idx = np.floor((p - lo) / (hi - lo) * res).astype(int)
-        inside = np.all((idx >= 0) & (idx < res), axis=-1)
-        i = np.clip(idx, 0, res - 1)
-        return np.where(inside, vol[i[..., 2], i[..., 1], i[..., 0]], 0.0)
+        return C.grid_extinction(vol, side, p)
 
     eye, dirs = C.camera_rays(side, width, height)
     sun = np.array(side["sun_direction"]) / np.linalg.norm(side["sun_direction"])
