@@ -133,6 +133,59 @@ const CHAR_PX: f64 = 7.0;
 /// the x labels and caption (45 and about 30).
 const PLOT_PX: (f64, f64) = (900.0 - 30.0 - 70.0, 600.0 - 30.0 - 45.0 - 30.0);
 
+/// The height of a ring's label, px (its 15 px font and a little room).
+const LABEL_PX: f64 = 18.0;
+
+/// Where each ring's label starts, as a pixel offset of its top-left
+/// corner from the ring's centre, for rings at `(x, y, characters)` (px
+/// in the plot area, y down): the first of eight places around the ring
+/// (right of it first, then left, then above and below those, then
+/// straight above and below) whose box stays inside
+/// the plot and overlaps neither an earlier label's box nor another
+/// ring; the right-hand place if none is free. Two defaults that sit
+/// at nearly the same cost and error had their labels drawn over each
+/// other.
+fn label_offsets(rings: &[(f64, f64, usize)]) -> Vec<(i32, i32)> {
+    const GAP: f64 = 14.0;
+    const RING: f64 = 10.0;
+    let mut boxes: Vec<[f64; 4]> = Vec::new();
+    let overlaps =
+        |a: &[f64; 4], b: &[f64; 4]| a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+    rings
+        .iter()
+        .enumerate()
+        .map(|(i, &(x, y, chars))| {
+            let w = chars as f64 * CHAR_PX;
+            let h = LABEL_PX;
+            let places = [
+                (GAP, -8.0),
+                (-GAP - w, -8.0),
+                (GAP, -8.0 - h),
+                (GAP, -8.0 + h),
+                (-GAP - w, -8.0 - h),
+                (-GAP - w, -8.0 + h),
+                (-0.5 * w, -GAP - h),
+                (-0.5 * w, GAP),
+            ];
+            let free = |&(dx, dy): &(f64, f64)| {
+                let b = [x + dx, y + dy, x + dx + w, y + dy + h];
+                let inside = b[0] >= 0.0 && b[2] <= PLOT_PX.0 && b[1] >= 0.0 && b[3] <= PLOT_PX.1;
+                let clear_rings = rings.iter().enumerate().all(|(j, r)| {
+                    j == i || !overlaps(&b, &[r.0 - RING, r.1 - RING, r.0 + RING, r.1 + RING])
+                });
+                inside && clear_rings && boxes.iter().all(|o| !overlaps(&b, o))
+            };
+            let (dx, dy) = places
+                .iter()
+                .copied()
+                .find(|p| free(p))
+                .unwrap_or(places[0]);
+            boxes.push([x + dx, y + dy, x + dx + w, y + dy + h]);
+            (dx.round() as i32, dy.round() as i32)
+        })
+        .collect()
+}
+
 /// Draws the series on log-log axes; `marked` points get a black ring and
 /// a label.
 pub fn loglog_png(
@@ -238,22 +291,20 @@ pub fn loglog_png(
                 .draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(|e| err(&e))?;
         }
-        for (x, y, label) in marked {
-            // The label starts beside the ring (a pixel offset, so it never
-            // runs under the ring whatever the axes' scale), on the ring's
-            // left when it would run past the plot's right edge.
-            let width = (label.chars().count() as f64 * CHAR_PX) as i32;
-            let room = (1.0 - unit((*x, *y)).0) * PLOT_PX.0;
-            let dx = if f64::from(width + 14) > room {
-                -14 - width
-            } else {
-                14
-            };
+        // Each label beside its ring, clear of the labels placed before it.
+        let rings: Vec<(f64, f64, usize)> = marked
+            .iter()
+            .map(|(x, y, label)| {
+                let (u, v) = unit((*x, *y));
+                (u * PLOT_PX.0, (1.0 - v) * PLOT_PX.1, label.chars().count())
+            })
+            .collect();
+        for ((x, y, label), (dx, dy)) in marked.iter().zip(label_offsets(&rings)) {
             chart
                 .draw_series(std::iter::once(
                     EmptyElement::at((*x, *y))
                         + Circle::new((0, 0), 9, BLACK.stroke_width(2))
-                        + Text::new(label.clone(), (dx, -8), ("sans-serif", 15)),
+                        + Text::new(label.clone(), (dx, dy), ("sans-serif", 15)),
                 ))
                 .map_err(|e| err(&e))?;
         }
@@ -366,6 +417,35 @@ mod tests {
         let (bold, _) = log_ticks(1e-4, 300.0);
         assert_eq!(bold.len(), 7);
         assert!(log_ticks(0.0, 1.0).0.is_empty());
+    }
+
+    #[test]
+    fn ring_labels_do_not_overlap() {
+        // The H200's render-error plot: "octaves 3" and "shadow_steps 20"
+        // ringed 18 px apart on one level; both labels went right of
+        // their rings, one over the other.
+        let rings = [(430.0, 340.0, 11), (448.0, 338.0, 17), (300.0, 340.0, 10)];
+        let offsets = label_offsets(&rings);
+        let boxes: Vec<[f64; 4]> = rings
+            .iter()
+            .zip(&offsets)
+            .map(|(r, o)| {
+                let (x, y) = (r.0 + o.0 as f64, r.1 + o.1 as f64);
+                [x, y, x + r.2 as f64 * CHAR_PX, y + LABEL_PX]
+            })
+            .collect();
+        for i in 0..boxes.len() {
+            for j in i + 1..boxes.len() {
+                let (a, b) = (boxes[i], boxes[j]);
+                let apart = a[2] <= b[0] || b[2] <= a[0] || a[3] <= b[1] || b[3] <= a[1];
+                assert!(apart, "labels {i} and {j}: {a:?} {b:?}");
+            }
+        }
+        // A lone ring keeps the label on its right; one at the right edge
+        // puts it on the left.
+        assert_eq!(label_offsets(&[(100.0, 200.0, 8)]), vec![(14, -8)]);
+        let (dx, _) = label_offsets(&[(PLOT_PX.0 - 5.0, 200.0, 8)])[0];
+        assert!(dx < 0, "{dx}");
     }
 
     #[test]
