@@ -370,6 +370,13 @@ fn shadow_parts(steps: u32) -> f32 {
     return parts;
 }
 
+// Where each of a pixel's shadow samples sits in its step: the pixel's
+// dither shifted off the march's own, so TSAA's frames average the shadow
+// ray's error over its samples' placements (the CPU's `shadow_offset`).
+fn shadow_offset(dither: f32) -> f32 {
+    return fract(dither + GOLDEN);
+}
+
 // The length of the shadow ray from p toward the sun: to the band's top,
 // at most SHADOW_RAY_M (the CPU's `shadow_ray_length`). The march takes
 // its shadow_step_count steps of growing length (√1, √2, √3, ... parts of
@@ -790,6 +797,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let ground = ground_up(sun_dir, SEA) * 0.25;
     let cos_theta = dot(dir, sun_dir);
     let forward = forward_step_factor(cos_theta);
+    let offset = shadow_offset(dither);
     var transmittance = 1.0;
     var light = vec3f(0.0);
     var depth_weighted = 0.0;
@@ -830,7 +838,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
         var t = 0.0;
         if k < shadow_count {
             dt = shadow_length * sqrt(f32(k + 1u)) / parts;
-            q = lit_p + sun_dir * (shadow_t + 0.5 * dt);
+            q = lit_p + sun_dir * (shadow_t + offset * dt);
             if height_fraction(q.y) > 1.0 {
                 k = shadow_count;
             } else {

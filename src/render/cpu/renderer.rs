@@ -10,7 +10,8 @@ use std::f32::consts::PI;
 use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::light_volume::LightVolume;
 use super::lighting::{
-    diffused_fluence, forward_step_factor, integrate_step, sun_optical_depth, sun_scattering,
+    ShadowSteps, diffused_fluence, forward_step_factor, integrate_step, shadow_offset,
+    sun_optical_depth, sun_scattering,
 };
 use super::sea::sea_reflection_change;
 use super::sky::{
@@ -226,7 +227,11 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     let sky_top = sky_ambient(sky, sun_dir) * 0.25;
     let ground = ground_up(sky, sun_dir, q.sea_wind_mps.is_some()) * 0.25;
     let cos = dir.dot(sun_dir);
-    let forward = forward_step_factor(cos);
+    let shadow_ray = ShadowSteps {
+        steps: q.shadow_steps,
+        forward: forward_step_factor(cos),
+        offset: shadow_offset(dither),
+    };
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
     let mut depth_weighted = 0.0_f32;
@@ -257,15 +262,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             if sigma_t <= 0.0 {
                 continue;
             }
-            let tau_sun = sun_optical_depth(
-                p,
-                sun_dir,
-                q.shadow_steps,
-                forward,
-                footprint,
-                &fr.fields,
-                d,
-            );
+            let tau_sun = sun_optical_depth(p, sun_dir, shadow_ray, footprint, &fr.fields, d);
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
             // Sky light from above, darker toward the cloud base, and the
             // ground's from below.
