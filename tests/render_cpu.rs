@@ -300,8 +300,8 @@ fn the_shadow_rays_offsets_average_to_the_exact_optical_depth() {
             (mean / exact - 1.0).abs() < 0.005,
             "from {start}: mean over offsets {mean} vs {exact}"
         );
-        let centred = sun_optical_depth(start, sun, centred(20), 0.0, &f, &d) as f64;
-        centred_worst = centred_worst.max((centred / exact - 1.0).abs());
+        let at_centres = sun_optical_depth(start, sun, centred(20), 0.0, &f, &d) as f64;
+        centred_worst = centred_worst.max((at_centres / exact - 1.0).abs());
     }
     // The test means something: one placement alone is off.
     assert!(centred_worst > 0.02, "centred steps off by {centred_worst}");

@@ -142,7 +142,8 @@ const LABEL_PX: f64 = 18.0;
 /// (right of it first, then left, then above and below those, then
 /// straight above and below) whose box stays inside
 /// the plot and overlaps neither an earlier label's box nor another
-/// ring; the right-hand place if none is free. Two defaults that sit
+/// ring; if none is, the first that stays inside the plot (else the
+/// right-hand place). Two defaults that sit
 /// at nearly the same cost and error had their labels drawn over each
 /// other.
 fn label_offsets(rings: &[(f64, f64, usize)]) -> Vec<(i32, i32)> {
@@ -166,22 +167,26 @@ fn label_offsets(rings: &[(f64, f64, usize)]) -> Vec<(i32, i32)> {
                 (-GAP - w, -8.0 + h),
                 (-0.5 * w, -GAP - h),
                 (-0.5 * w, GAP),
-            ];
+            ]
+            .map(|(dx, dy): (f64, f64)| (dx.round(), dy.round()));
+            let inside = |&(dx, dy): &(f64, f64)| {
+                x + dx >= 0.0 && x + dx + w <= PLOT_PX.0 && y + dy >= 0.0 && y + dy + h <= PLOT_PX.1
+            };
             let free = |&(dx, dy): &(f64, f64)| {
                 let b = [x + dx, y + dy, x + dx + w, y + dy + h];
-                let inside = b[0] >= 0.0 && b[2] <= PLOT_PX.0 && b[1] >= 0.0 && b[3] <= PLOT_PX.1;
                 let clear_rings = rings.iter().enumerate().all(|(j, r)| {
                     j == i || !overlaps(&b, &[r.0 - RING, r.1 - RING, r.0 + RING, r.1 + RING])
                 });
-                inside && clear_rings && boxes.iter().all(|o| !overlaps(&b, o))
+                inside(&(dx, dy)) && clear_rings && boxes.iter().all(|o| !overlaps(&b, o))
             };
             let (dx, dy) = places
                 .iter()
                 .copied()
                 .find(|p| free(p))
+                .or_else(|| places.iter().copied().find(|p| inside(p)))
                 .unwrap_or(places[0]);
             boxes.push([x + dx, y + dy, x + dx + w, y + dy + h]);
-            (dx.round() as i32, dy.round() as i32)
+            (dx as i32, dy as i32)
         })
         .collect()
 }
@@ -440,6 +445,25 @@ mod tests {
                 let apart = a[2] <= b[0] || b[2] <= a[0] || a[3] <= b[1] || b[3] <= a[1];
                 assert!(apart, "labels {i} and {j}: {a:?} {b:?}");
             }
+        }
+        // No label sits on another ring.
+        for (k, b) in boxes.iter().enumerate() {
+            for (j, r) in rings.iter().enumerate() {
+                let clear = k == j
+                    || b[2] <= r.0 - 10.0
+                    || r.0 + 10.0 <= b[0]
+                    || b[3] <= r.1 - 10.0
+                    || r.1 + 10.0 <= b[1];
+                assert!(clear, "label {k} on ring {j}");
+            }
+        }
+        // Where every place is taken, a label still stays in the plot:
+        // rings packed along the right edge.
+        let packed: Vec<(f64, f64, usize)> = (0..12)
+            .map(|k| (PLOT_PX.0 - 6.0, 100.0 + 4.0 * k as f64, 12))
+            .collect();
+        for ((x, _, n), (dx, _)) in packed.iter().zip(label_offsets(&packed)) {
+            assert!(x + dx as f64 + *n as f64 * CHAR_PX <= PLOT_PX.0, "{dx}");
         }
         // A lone ring keeps the label on its right; one at the right edge
         // puts it on the left.

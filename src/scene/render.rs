@@ -65,9 +65,10 @@ pub struct RenderSettings {
     pub steps: u32,
     /// Shadow march steps toward the sun (0..=64; 0 = off). Default 20:
     /// fewer, longer steps miss small wisps and leak light (against the
-    /// path tracer, the full backlit picture is +7 % too bright at 20,
-    /// +11 % at 16, +23 % at 12; its single scattering alone +31 % at 20,
-    /// +12 % at 32, +7 % at 48; docs/ground_truth).
+    /// path tracer on a 1024-cell grid, the backlit view's single
+    /// scattering is 12.4 % off per pixel at 20, 9.5 % at 32, 9.0 % at
+    /// 64, and 35 % at 12 with the samples at their steps' centres;
+    /// docs/ground_truth, 2026-12-04).
     pub shadow_steps: u32,
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
     /// (the light was fitted to the path tracer with 3). 0 turns multiple
@@ -89,9 +90,11 @@ pub struct RenderSettings {
     pub tsaa: bool,
     /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
     pub tsaa_blend: f32,
-    /// CPU pictures: marches per pixel, their samples shifted by `k / n`
-    /// of a step, averaged (1..=64; 1 shows the fixed dither's fine
-    /// checker at 48 steps). Default 4.
+    /// CPU pictures: marches per pixel, averaged, march `k` with the
+    /// dither shifted by frame `k`'s golden-ratio offset (the GPU's TSAA
+    /// frames' offsets), which moves its samples and its shadow samples
+    /// within their steps (1..=64; 1 shows the dither's fine grain at 48
+    /// steps). Default 4.
     pub cpu_offsets: u32,
     /// The cloud map (`[render.cloud_map]`).
     pub cloud_map: CloudMapConfig,

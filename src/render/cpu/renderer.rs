@@ -177,7 +177,8 @@ pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32) -> Vec3 {
 }
 
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
-/// in `[0, 1)` places the samples within their steps (0.5: centres);
+/// in `[0, 1)` places the samples within their steps (0.5: centres) and,
+/// through [`shadow_offset`], each lit sample's shadow samples in theirs;
 /// `spread` is the pixel's cone angle (radians, [`View::pixel_spread`]):
 /// a sample at distance `t` reads the textures at the level of detail of
 /// a footprint `spread · t` wide.
