@@ -2,7 +2,7 @@
 //! height, tabulated once on a fine grid so that a parcel's lookup is O(1).
 //!
 //! Two sources build it: a [`ParametricProfile`] (lapse rate, inversion,
-//! humidity decay) or a [`Sounding`](super::sounding::Sounding). Pressure
+//! humidity decay) or a [`super::sounding::Sounding`]. Pressure
 //! is integrated hydrostatically, `dp/dz = -p g / (R_d T_v)`, unless the
 //! sounding gives it. Supersaturated input (relative humidity above 1) is
 //! kept as environmental condensate (haze/fog): vapour is capped at

@@ -8,22 +8,22 @@
 //!
 //! Passes, in order (each exists only when the scene needs it), each in
 //! its own module:
-//! 1. `terrain` (scene has terrain, [`super::terrain_pass`]): the
+//! 1. `terrain` (scene has terrain, `terrain_pass`): the
 //!    heightfield mesh into an HDR colour target and a depth buffer.
 //! 2. `light_volume` (multiple scattering on, [`super::light_volume_pass`]):
 //!    compute passes submitted before the frame's, only when P, the sun or
 //!    the density changed: the sunlight diffused through the clouds.
-//! 3. `clouds` ([`super::cloud_pass`]): full-screen; marches the band
+//! 3. `clouds` (`cloud_pass`): full-screen; marches the band
 //!    segment of each ray up to the depth (terrain or an external depth
 //!    buffer) into the cloud layer (premultiplied radiance, opacity) and,
 //!    with TSAA, the cloud distance.
 //! 4. `tsaa` (TSAA on, [`super::tsaa`]): reprojects, clamps and blends the
 //!    history (ping-pong pair).
-//! 5. `composite` ([`super::composite_pass`]): clouds over the sky or
+//! 5. `composite` (`composite_pass`): clouds over the sky or
 //!    terrain, tone-mapped into an 8-bit target (linear radiance into a
 //!    floating-point one).
 //!
-//! Every pass reads bind group 0 ([`super::inputs`]). Size-dependent
+//! Every pass reads bind group 0 (`inputs`). Size-dependent
 //! targets belong to the pass that writes them and are remade on resize.
 
 use glam::Mat4;

@@ -10,7 +10,7 @@ use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::sky_luts::SkyParams;
 
 /// What the renderer draws and how well. Changing it with
-/// [`CloudRenderer::set_settings`] rebuilds only what changed.
+/// [`CloudRenderer::set_settings`](super::CloudRenderer::set_settings) rebuilds only what changed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GpuSettings {
     pub density: DensityParams,

@@ -6,7 +6,7 @@
 //! the camera's altitude) do: the pass keeps the last inputs and skips a
 //! build whose inputs are equal. The renderer's passes read the tables
 //! under the physical sky (`shaders/sky_physical.wgsl`, bindings 7 to 11
-//! of group 0, [`super::inputs`]).
+//! of group 0, `inputs`).
 
 use glam::Vec3;
 
