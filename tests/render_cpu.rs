@@ -521,6 +521,45 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
     assert_eq!(grey, 0, "no cloud pixels without coverage");
 }
 
+/// A CPU still (`render_still`, what `cumulus render --backend cpu`
+/// writes) averages its `cpu_offsets` marches as the GPU's first TSAA
+/// frames, sub-pixel jitter included: it lands closer to a 4x4
+/// box-filtered image of the same scene than the same four marches
+/// through the pixels' centres, whose cloud outlines and far ground
+/// shadows are staircases; one offset is still `render_linear`.
+#[test]
+fn a_still_is_anti_aliased_like_the_gpus_frames() {
+    use cumulus::prepare::Prepared;
+    use cumulus::render::cpu::renderer::{
+        render_converged, render_linear_offsets, render_still, supersampled_srgb8,
+    };
+    let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
+        .expect("shipped scene");
+    sc.render.time_s = 1800.0;
+    let p = Prepared::from_scene(&sc, || {}).expect("prepare");
+    let r = &sc.render;
+    let (w, h) = (96, 72);
+    let f = p.frame(r, r.quality());
+    let reference = supersampled_srgb8(w, h, 4, &f);
+    let err = |img: &[Vec3]| {
+        let b = to_srgb8(img, r.exposure);
+        b.iter()
+            .zip(&reference)
+            .map(|(x, y)| x.abs_diff(*y) as f64)
+            .sum::<f64>()
+            / (255.0 * b.len() as f64)
+    };
+    let still = render_still(w, h, &f, 4);
+    assert_eq!(still, render_converged(w, h, &f, 4));
+    assert_eq!(render_still(w, h, &f, 1), render_linear(w, h, &f));
+    let (e_still, e_centres) = (err(&still), err(&render_linear_offsets(w, h, &f, 4)));
+    eprintln!("against 4x4 supersampling: still {e_still:.5}, centres {e_centres:.5}");
+    assert!(
+        e_still < 0.9 * e_centres,
+        "still {e_still}, centres {e_centres}"
+    );
+}
+
 /// Averaging the march over shifted sample offsets (what `render.cpu_offsets`
 /// does for CPU pictures) takes the fixed dither's pattern out: at 24 steps,
 /// four offsets land at least a third closer to a 384-step image than one,

@@ -85,16 +85,18 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Physics seconds simulated before the picture (>= 0). Default 2400.
     pub time_s: f64,
-    /// Temporal anti-aliasing on the GPU (the CPU reference never jitters).
+    /// Temporal anti-aliasing on the GPU (CPU pictures average
+    /// `cpu_offsets` of the same jittered frames instead).
     /// Off: no jitter, no history textures, no TSAA pass. Default true.
     pub tsaa: bool,
     /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
     pub tsaa_blend: f32,
-    /// CPU pictures: marches per pixel, averaged, march `k` with the
-    /// dither shifted by frame `k`'s golden-ratio offset (the GPU's TSAA
-    /// frames' offsets), which moves its samples and its shadow samples
-    /// within their steps (1..=64; 1 shows the dither's fine grain at 48
-    /// steps). Default 4.
+    /// CPU pictures: marches per pixel, averaged, march `k` as the GPU's
+    /// TSAA frame `k` (its sub-pixel jitter, which anti-aliases edges, and
+    /// its golden-ratio dither offset, which moves the samples and the
+    /// shadow samples within their steps; `render_still`). 1: one march
+    /// through each pixel's centre, which shows the dither's fine grain
+    /// at 48 steps (1..=64). Default 4.
     pub cpu_offsets: u32,
     /// The cloud map (`[render.cloud_map]`).
     pub cloud_map: CloudMapConfig,

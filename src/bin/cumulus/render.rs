@@ -103,7 +103,7 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::renderer::{Quality, render_linear_offsets};
+    use cumulus::render::cpu::renderer::{Quality, render_still};
     use cumulus::report::render_quality;
 
     let flags = [
@@ -240,7 +240,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
-    let linear = render_linear_offsets(r.width, r.height, &frame, r.cpu_offsets);
+    let linear = render_still(r.width, r.height, &frame, r.cpu_offsets);
     let elapsed = start.elapsed();
 
     write_linear(out, picture, r, &linear)?;

@@ -423,6 +423,21 @@ pub fn render_converged(width: u32, height: u32, fr: &Frame, frames: u32) -> Vec
         .collect()
 }
 
+/// A still picture (`cumulus render --backend cpu`): with `offsets` of 2
+/// or more, the mean of the first `offsets` frames the GPU's TSAA
+/// accumulates ([`render_converged`]: each frame's sub-pixel jitter and
+/// dither offset), so edges are anti-aliased as the GPU's accumulated
+/// frames are (through pixel centres alone, the far ground's cloud
+/// shadows and the clouds' outlines against the sky were staircases);
+/// with 1, one march through each pixel's centre ([`render_linear`]).
+pub fn render_still(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec3> {
+    if offsets <= 1 {
+        render_linear(width, height, fr)
+    } else {
+        render_converged(width, height, fr, offsets)
+    }
+}
+
 /// Per pixel (rayon over rows, row-major) the mean over `frames` marches
 /// of `pick` of the ray's sample: through the pixel's centre with frame
 /// `k`'s dither offset, or (`jittered`) also with its sub-pixel jitter.
