@@ -560,8 +560,8 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
     );
 }
 
-/// Averaging the march over shifted sample offsets (what `render.cpu_offsets`
-/// does for CPU pictures) takes the fixed dither's pattern out: at 24 steps,
+/// Averaging the march over shifted sample offsets (the dither half of what
+/// `render.cpu_offsets` does for CPU pictures) takes the fixed dither's pattern out: at 24 steps,
 /// four offsets land at least a third closer to a 384-step image than one,
 /// and one offset is `render_linear` exactly.
 #[test]

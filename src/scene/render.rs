@@ -96,7 +96,9 @@ pub struct RenderSettings {
     /// its golden-ratio dither offset, which moves the samples and the
     /// shadow samples within their steps; `render_still`). 1: one march
     /// through each pixel's centre, which shows the dither's fine grain
-    /// at 48 steps (1..=64). Default 4.
+    /// at 48 steps (1..=64). Default 4. The endless volumes' pictures
+    /// average the dither offsets through pixel centres (no TSAA on their
+    /// GPU pass); the spheroids' take one march.
     pub cpu_offsets: u32,
     /// The cloud map (`[render.cloud_map]`).
     pub cloud_map: CloudMapConfig,

@@ -1,7 +1,8 @@
 //! The CPU reference renderer: per pixel (rayon over rows), deterministic
 //! (one frame: rays through pixel centres, each pixel's blue-noise dither),
-//! any step count; and the converged oracle that averages the very frames
-//! the GPU's TSAA accumulates (`render_converged`).
+//! any step count; the converged oracle that averages the very frames
+//! the GPU's TSAA accumulates (`render_converged`); and the CLI's stills,
+//! the first `cpu_offsets` of those frames (`render_still`).
 
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -415,7 +416,9 @@ pub fn render_linear_offsets(width: u32, height: u32, fr: &Frame, offsets: u32) 
 /// jitter and dither offset, [`jitter`]); with more steps than the GPU's
 /// (the caller's `fr`), the clean image the GPU's converged frames are
 /// measured against. `frames` is best a multiple of
-/// [`sampling::JITTER_CYCLE`].
+/// [`sampling::JITTER_CYCLE`]. Past the cycle the sub-pixel jitter
+/// repeats but the dither offsets go on ([`frame_offset`]), so every
+/// frame differs (the GPU repeats both; up to the cycle the two agree).
 pub fn render_converged(width: u32, height: u32, fr: &Frame, frames: u32) -> Vec<Vec3> {
     render_marches(width, height, fr, frames, true, |s| s.radiance.extend(0.0))
         .into_iter()
@@ -460,11 +463,16 @@ fn render_marches(
                 let d0 = pixel_dither(x as u32, y as u32);
                 let mut sum = Vec4::ZERO;
                 for k in 0..n {
-                    let [jx, jy, offset] = if jittered {
-                        jitter(k)
+                    // Frame k's dither offset, past the jitter's cycle too
+                    // (the same as `jitter(k)`'s within it), so that more
+                    // than JITTER_CYCLE stills' marches are all distinct.
+                    let [jx, jy] = if jittered {
+                        let [jx, jy, _] = jitter(k);
+                        [jx, jy]
                     } else {
-                        [0.0, 0.0, frame_offset(k)]
+                        [0.0, 0.0]
                     };
+                    let offset = frame_offset(k);
                     let dir =
                         fr.view
                             .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);

@@ -55,8 +55,9 @@ pub fn hazed_clouds(
 /// mean of `offsets` `march(origin, dir, dither)` through its centre,
 /// march `k` with the dither shifted by the golden-ratio offset of frame
 /// `k` (one offset: the dither itself, the twin of one GPU frame; more:
-/// its grain averaged away, as the cloud map's CPU path does with
-/// `render.cpu_offsets`), over the sky or ground behind.
+/// its grain averaged away), over the sky or ground behind. Unlike the
+/// cloud map's stills (`render_still`), no sub-pixel jitter: the
+/// volumes' GPU pass has no TSAA to match.
 pub fn render_standalone(
     width: u32,
     height: u32,
