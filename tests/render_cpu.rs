@@ -187,6 +187,24 @@ fn transmittance_is_in_unit_range_and_monotone_along_a_ray() {
     }
 }
 
+/// The optical depth over `length` m from `start` toward `sun`, by an
+/// `n`-point midpoint quadrature of the density (detail at `footprint`).
+fn optical_depth_quadrature(
+    start: Vec3,
+    sun: Vec3,
+    length: f32,
+    n: u32,
+    footprint: f32,
+    f: &Fields,
+    d: &DensityParams,
+) -> f64 {
+    let dt = length / n as f32;
+    (0..n)
+        .map(|i| density_at(start + sun * ((i as f32 + 0.5) * dt), f, d, true, footprint) as f64)
+        .sum::<f64>()
+        * dt as f64
+}
+
 #[test]
 fn a_low_suns_shadow_ray_crosses_the_whole_band() {
     // From the band's bottom toward a sun 8° up, the light crosses 7.2 km
@@ -219,20 +237,7 @@ fn a_low_suns_shadow_ray_crosses_the_whole_band() {
             (length - through).abs() < 1.0 && length > 2.0 * SHADOW_STEP_SPAN_M,
             "{length} m"
         );
-        let n = 100_000;
-        let dt = length / n as f32;
-        let exact: f64 = (0..n)
-            .map(|i| {
-                density_at(
-                    start + sun * ((i as f32 + 0.5) * dt),
-                    &f,
-                    &d,
-                    true,
-                    footprint,
-                ) as f64
-                    * dt as f64
-            })
-            .sum();
+        let exact = optical_depth_quadrature(start, sun, length, 100_000, footprint, &f, &d);
         let tau = sun_optical_depth(start, sun, centred(20), footprint, &f, &d) as f64;
         assert!(exact > 1.0, "a real shadow: τ = {exact}");
         assert!(
@@ -271,12 +276,7 @@ fn the_shadow_rays_offsets_average_to_the_exact_optical_depth() {
         Vec3::new(4321.0, 900.0, 6543.0),
     ] {
         let length = shadow_ray_length(start, sun, &d);
-        let n = 200_000;
-        let dt = length / n as f32;
-        let exact: f64 = (0..n)
-            .map(|i| density_at(start + sun * ((i as f32 + 0.5) * dt), &f, &d, true, 0.0) as f64)
-            .sum::<f64>()
-            * dt as f64;
+        let exact = optical_depth_quadrature(start, sun, length, 200_000, 0.0, &f, &d);
         assert!(exact > 1.0, "a real shadow: τ = {exact}");
         let offsets = 128;
         let mean: f64 = (0..offsets)
