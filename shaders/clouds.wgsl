@@ -481,17 +481,17 @@ struct Aerial {
 const LAND_ALBEDO: vec3f = vec3f(0.08, 0.1, 0.06);
 
 // The flat land's own light (the CPU's `land_surface`).
-fn land_surface(sun_dir: vec3f, shadow: f32) -> vec3f {
+fn land_surface(sun_dir: vec3f, shadow: f32, albedo: vec3f) -> vec3f {
     let sun = sun_light_at(0.0, sun_dir);
     let lit = sun * (max(sun_dir.y, 0.0) * shadow / PI) + sky_ambient(sun_dir);
-    return LAND_ALBEDO * lit;
+    return albedo * lit;
 }
 
 // The flat land through the air, its sunlit part dimmed by the clouds'
 // shadow, with the sunlight the clouds scatter down onto it (the CPU's
 // `land_radiance`).
-fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32) -> vec3f {
-    let surface = land_surface(sun_dir, shadow) + LAND_ALBEDO * ground_cloud_light(sun_dir);
+fn land_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, albedo: vec3f) -> vec3f {
+    let surface = land_surface(sun_dir, shadow, albedo) + albedo * ground_cloud_light(sun_dir);
     return ground_haze(surface, dir, sun_dir);
 }
 
@@ -695,19 +695,20 @@ fn ground_up(sun_dir: vec3f, sea: bool) -> vec3f {
         let sun = sun_light_at(0.0, sun_dir);
         return sky_above(vec3f(0.0, 1.0, 0.0), sun_dir) * WATER_F0 + water_light(sun, sun_dir) * (1.0 - WATER_F0);
     }
-    return land_surface(sun_dir, 1.0);
+    return land_surface(sun_dir, 1.0, LAND_ALBEDO);
 }
 
-// The sky and the sun disk, or below the horizon the land or the sea in
-// the clouds' shadow (the CPU's `background_radiance`).
-fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> vec3f {
+// The sky and the sun disk, or below the horizon the land (of albedo
+// `land`) or the sea in the clouds' shadow (the CPU's
+// `background_radiance`).
+fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, land: vec3f, reflection: vec4f) -> vec3f {
     if dir.y >= 0.0 {
         return sky_above(dir, sun_dir) + sun_disk(dir, sun_dir);
     }
     if SEA {
         return sea_radiance(dir, sun_dir, shadow, reflection);
     }
-    return land_radiance(dir, sun_dir, shadow);
+    return land_radiance(dir, sun_dir, shadow, land);
 }
 
 // The blue-noise tile's offset of pixel (x, y) (the CPU's `pixel_dither`).

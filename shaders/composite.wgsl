@@ -42,5 +42,6 @@ fn sky_background(pos: vec2f) -> vec3f {
     let eye = frame.cam_pos.xyz;
     // The clouds the sea mirrors are in the cloud layer (the cloud pass's
     // sea_reflection_change, accumulated by TSAA): the sea here is bare.
-    return background_radiance(dir, sun_dir, flat_ground_shadow(eye, dir, sun_dir), vec4f(0.0, 0.0, 0.0, 1.0));
+    let land = flat_ground_albedo(eye, dir, frame.cam_pos.w);
+    return background_radiance(dir, sun_dir, flat_ground_shadow(eye, dir, sun_dir), land, vec4f(0.0, 0.0, 0.0, 1.0));
 }

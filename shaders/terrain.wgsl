@@ -3,7 +3,7 @@
 // camera to the longest ray, into an HDR colour target and a depth buffer.
 // It is lit by the sun through the clouds (their shadow) and the sky, and
 // faded by aerial perspective: the twins of `height_at`, `normal_at`,
-// `terrain_radiance` and `cloud_shadow` in src/render/.
+// `terrain_albedo`, `terrain_radiance` and `cloud_shadow` in src/render/.
 
 @group(1) @binding(0) var height_tex: texture_2d<f32>;
 
@@ -42,10 +42,19 @@ fn normal_at(x: f32, z: f32) -> vec3f {
 const TERRAIN_ALBEDO_FLAT: vec3f = vec3f(0.07, 0.11, 0.04);
 const TERRAIN_ALBEDO_STEEP: vec3f = vec3f(0.16, 0.13, 0.09);
 
+// The terrain's albedo, tinted by the fields and woods when LAND_FIELDS
+// (the CPU's `terrain_albedo`).
+fn terrain_albedo(p: vec3f, n: vec3f, footprint_m: f32) -> vec3f {
+    var flat = TERRAIN_ALBEDO_FLAT;
+    if LAND_FIELDS {
+        flat = TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, true) / LAND_ALBEDO;
+    }
+    return mix(flat, TERRAIN_ALBEDO_STEEP, min((1.0 - n.y) * 3.0, 1.0));
+}
+
 fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let n = normal_at(p.x, p.z);
-    let slope = 1.0 - n.y;
-    let albedo = mix(TERRAIN_ALBEDO_FLAT, TERRAIN_ALBEDO_STEEP, min(slope * 3.0, 1.0));
+    let albedo = terrain_albedo(p, n, ground_footprint(frame.cam_pos.w, t, dot(dir, n)));
     var shadow = 1.0;
     if SHADOW_STEPS > 0u && sun_dir.y > 0.0 {
         shadow = cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);

@@ -13,8 +13,8 @@ use cumulus::endless::{Database, Player};
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::Camera;
 use cumulus::render::cpu::renderer::to_srgb8;
-use cumulus::render::cpu::sky::SkyModel;
 use cumulus::render::cpu::sky::sun_direction;
+use cumulus::render::cpu::sky::{Land, SkyModel};
 use cumulus::render::cpu::spheroids::{LightGrid, render_spheroids_srgb8};
 use cumulus::render::cpu::volume::render_volume;
 use cumulus::render::gpu::Headless;
@@ -224,6 +224,9 @@ fn spheroids_and_cloud_map_draw_the_same_parcels() {
     // The baseline draws under the analytic sky: its clear sky is the mask's
     // reference.
     sc.render.atmosphere.model = SkyModel::Analytic;
+    // The baseline's land is plain (its backgrounds have no fields): so is
+    // the cloud map's here, or every ground pixel would differ from it.
+    sc.render.ground.land = Land::Plain;
     let p = Prepared::from_scene(&sc, || {}).unwrap();
     let l = sc.physics.domain_size_m as f32;
     // Straight down on the whole domain from above the layer.

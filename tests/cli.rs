@@ -857,6 +857,11 @@ fn a_bad_ground_names_its_key() {
         None,
         &["bad.toml", "render.ground.wind_speed_mps", "0..=30"],
     );
+    assert_simulate_fails(
+        "[render.ground]\nland = \"forest\"\n",
+        None,
+        &["bad.toml", "forest", "fields", "plain"],
+    );
 }
 
 #[test]

@@ -10,7 +10,7 @@ use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::View;
 use cumulus::render::cpu::renderer::{
-    flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
+    flat_ground_albedo, flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
 };
 use cumulus::render::cpu::sea::sea_reflection;
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};
@@ -327,6 +327,7 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
                 sun,
                 q.sea_wind_mps,
                 shadow,
+                flat_ground_albedo(view.eye(), dir, spread, &frame),
                 reflection,
             );
             Vec3::new(px[0], px[1], px[2]) + (1.0 - px[3]) * sky

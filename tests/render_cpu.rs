@@ -18,7 +18,7 @@ use cumulus::render::cpu::sea::{
     reflected_ray, sea_reflection,
 };
 use cumulus::render::cpu::sky::{
-    AtmosphereConfig, SkyModel, background_radiance, sun_direction, sun_light_at,
+    AtmosphereConfig, LAND_ALBEDO, SkyModel, background_radiance, sun_direction, sun_light_at,
 };
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
@@ -389,6 +389,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
             max_distance_m: 1e5,
             exposure: 1.0,
             sea_wind_mps: None,
+            land_fields: false,
             atmosphere: AtmosphereConfig {
                 model: SkyModel::Analytic,
                 ..AtmosphereConfig::default()
@@ -455,6 +456,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
             max_distance_m: 40_000.0,
             exposure: 1.2,
             sea_wind_mps: None,
+            land_fields: false,
             atmosphere: AtmosphereConfig {
                 model: SkyModel::Analytic,
                 ..AtmosphereConfig::default()
@@ -633,8 +635,17 @@ fn the_sea_mirrors_the_clouds_above_it() {
         let sky = fr.sky_light();
         let shadow = flat_ground_shadow(origin, dir, sun, &fr);
         let pixel = march_ray(origin, dir, 0.5, 1e-3, &fr).radiance;
-        let mirrored = background_radiance(&sky, dir, sun, Some(7.0), shadow, (light, t));
-        let bare = background_radiance(&sky, dir, sun, Some(7.0), shadow, (Vec3::ZERO, 1.0));
+        let mirrored =
+            background_radiance(&sky, dir, sun, Some(7.0), shadow, LAND_ALBEDO, (light, t));
+        let bare = background_radiance(
+            &sky,
+            dir,
+            sun,
+            Some(7.0),
+            shadow,
+            LAND_ALBEDO,
+            (Vec3::ZERO, 1.0),
+        );
         assert!((pixel - mirrored).abs().max_element() <= 1e-6 * mirrored.max_element().max(1.0));
         changed += ((mirrored - bare).abs().max_element() > 1e-3 * bare.max_element()) as u32;
         // No clouds, land, or a ray that looks up: nothing mirrored.
@@ -802,7 +813,7 @@ fn a_rough_sea_mirrors_clouds_the_mirror_ray_misses() {
 #[test]
 fn the_shade_under_clouds_gets_the_path_tracers_light() {
     use cumulus::prepare::Prepared;
-    use cumulus::render::cpu::sky::{LAND_ALBEDO, land_radiance};
+    use cumulus::render::cpu::sky::land_radiance;
     let bins = std::fs::read_to_string("docs/ground_truth/ground_shadow_bins.csv")
         .expect("the path tracer's reference");
     let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
@@ -825,7 +836,13 @@ fn the_shade_under_clouds_gets_the_path_tracers_light() {
         let frame = p.frame(&r, r.quality());
         let sun = sun_direction(elevation, 110.0);
         let dir = Vec3::new(0.0, -0.6, 0.8);
-        let shade = lum(land_radiance(&frame.sky_light(), dir, sun, 0.0)) / lum(LAND_ALBEDO);
+        let shade = lum(land_radiance(
+            &frame.sky_light(),
+            dir,
+            sun,
+            0.0,
+            LAND_ALBEDO,
+        )) / lum(LAND_ALBEDO);
         eprintln!("{view}: the shade's irradiance over π {shade:.3}, path tracer {truth:.3}");
         assert!(
             (shade / truth - 1.0).abs() < 0.12,

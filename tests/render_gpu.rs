@@ -142,6 +142,27 @@ fn gpu_matches_cpu_reference_over_the_sea() {
     );
 }
 
+/// The fields and woods (`[render.ground] land`, on by default) seen from
+/// 400 m looking 35° down, parcels a few pixels wide near the bottom and
+/// faded to their mean toward the horizon: the composite's
+/// `flat_ground_albedo` against the CPU's.
+#[test]
+fn gpu_matches_cpu_reference_on_the_fields() {
+    let Some(ctx) = gpu() else { return };
+    let mut sc = scene("fair_weather");
+    assert!(sc.render.quality().land_fields, "fields by default");
+    sc.render.camera_position_m = [5000.0, 400.0, 5000.0];
+    sc.render.camera_pitch_deg = -35.0;
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
+}
+
 #[test]
 fn gpu_matches_cpu_reference_above_and_inside_the_band() {
     let Some(ctx) = gpu() else { return };

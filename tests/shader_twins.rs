@@ -12,7 +12,7 @@ use std::mem::offset_of;
 use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
-use cumulus::render::cpu::{density, light_volume, lighting, renderer, sea, sky, sky_luts};
+use cumulus::render::cpu::{density, land, light_volume, lighting, renderer, sea, sky, sky_luts};
 use cumulus::render::gpu::light_volume_pass::{self, DiffusionGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
 use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
@@ -65,6 +65,16 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             "VOLUME_SHADOW_RAY_M",
             cumulus::render::cpu::volume::VOLUME_SHADOW_RAY_M as f64,
         ),
+        ("FIELD_LENGTH_M", land::FIELD_LENGTH_M as f64),
+        ("FIELD_WIDTH_M", land::FIELD_WIDTH_M as f64),
+        ("FIELD_ANGLE", land::FIELD_ANGLE as f64),
+        ("FARM_TURN", land::FARM_TURN as f64),
+        ("FARM_M", land::FARM_M as f64),
+        ("FARM_BEND_M", land::FARM_BEND_M as f64),
+        ("WOODS_TILE_M", land::WOODS_TILE_M as f64),
+        ("WOODS_DETAIL_TILE_M", land::WOODS_DETAIL_TILE_M as f64),
+        ("WOODS_THRESHOLD", land::WOODS_THRESHOLD as f64),
+        ("WOODS_EDGE", land::WOODS_EDGE as f64),
         ("BASE_RAMP", density::BASE_RAMP as f64),
         ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
@@ -293,6 +303,9 @@ fn rust_vectors() -> Vec<(&'static str, glam::Vec3)> {
         ("LAND_ALBEDO", sky::LAND_ALBEDO),
         ("TERRAIN_ALBEDO_FLAT", renderer::TERRAIN_ALBEDO_FLAT),
         ("TERRAIN_ALBEDO_STEEP", renderer::TERRAIN_ALBEDO_STEEP),
+        ("WOODS", land::WOODS),
+        ("CROPS_MEAN", land::CROPS_MEAN),
+        ("LAND_TINT_MEAN", land::LAND_TINT_MEAN),
     ]
 }
 

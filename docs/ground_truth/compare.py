@@ -108,6 +108,11 @@ def scene_variant(base, sun_el, sun_az, yaw, width, height, path, extra=()):
     # The path tracer's scene has no air: no aerial perspective on ours
     # either (the sky and the sun's colour stay the scene's).
     out.append("\n[render.atmosphere]\naerial_perspective = false")
+    # Its ground (ground_shadow.py's plane) is one colour: the plain land.
+    if "[render.ground]" in out:
+        out.insert(out.index("[render.ground]") + 1, 'land = "plain"')
+    else:
+        out.append('\n[render.ground]\nland = "plain"')
     # Paths inside the scene (soundings) are relative to scenes/.
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")

@@ -387,6 +387,7 @@ impl RenderSettings {
             max_distance_m: self.max_distance_m,
             exposure: self.exposure,
             sea_wind_mps: self.ground.sea_wind_mps(),
+            land_fields: self.ground.land_fields(),
             atmosphere: self.atmosphere,
             single_scattering: false,
         }

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
+use super::land::land_albedo;
 use super::light_volume::LightVolume;
 use super::lighting::{
     ShadowSteps, diffused_fluence, forward_step_factor, integrate_step, shadow_offset,
@@ -16,8 +17,8 @@ use super::lighting::{
 };
 use super::sea::sea_reflection_change;
 use super::sky::{
-    AtmosphereConfig, SkyLight, aerial, background_radiance, ground_cloud_light, ground_up,
-    sky_ambient, sun_direction, sun_light_at,
+    AtmosphereConfig, LAND_ALBEDO, SkyLight, aerial, background_radiance, ground_cloud_light,
+    ground_up, sky_ambient, sun_direction, sun_light_at,
 };
 use super::sky_luts::SkyLuts;
 pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
@@ -45,6 +46,10 @@ pub struct Quality {
     /// The sea below the horizon with this wind speed, m/s (`None`:
     /// land; [`super::sky::background_radiance`]).
     pub sea_wind_mps: Option<f32>,
+    /// The land drawn as fields and woods
+    /// ([`super::land::land_albedo`]); off: one colour,
+    /// [`super::sky::LAND_ALBEDO`]. Off under the sea.
+    pub land_fields: bool,
     /// The sky model and aerial perspective (`[render.atmosphere]`).
     pub atmosphere: AtmosphereConfig,
     /// Only the sun's light scattered once: no octaves, no sky or ground
@@ -193,7 +198,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
         .and_then(|h| h.intersect(origin, dir, q.max_distance_m).map(|t| (h, t)));
     let (background, max_t) = match hit {
         Some((h, t)) => (
-            terrain_radiance(origin + dir * t, t, dir, sun_dir, h, fr),
+            terrain_radiance(origin + dir * t, t, dir, sun_dir, spread, h, fr),
             t,
         ),
         None => (
@@ -203,6 +208,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
                 sun_dir,
                 q.sea_wind_mps,
                 flat_ground_shadow(origin, dir, sun_dir, fr),
+                flat_ground_albedo(origin, dir, spread, fr),
                 (Vec3::ZERO, 1.0),
             ) + sea_reflection_change(origin, dir, dither, sun_dir, spread, fr),
             q.max_distance_m,
@@ -329,22 +335,24 @@ pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
 pub const TERRAIN_ALBEDO_FLAT: Vec3 = Vec3::new(0.07, 0.11, 0.04);
 pub const TERRAIN_ALBEDO_STEEP: Vec3 = Vec3::new(0.16, 0.13, 0.09);
 
-/// Radiance of the terrain at `p` (distance `t` along `dir`): lit by the
-/// sun through the clouds (their shadow, when shadows are on), the sky
-/// and the sunlight the clouds scatter down (`ground_cloud_light`), faded
-/// by aerial perspective.
+/// Radiance of the terrain at `p` (distance `t` along `dir`, seen by a
+/// pixel of cone angle `spread`): lit by the sun through the clouds
+/// (their shadow, when shadows are on), the sky and the sunlight the
+/// clouds scatter down (`ground_cloud_light`), faded by aerial
+/// perspective. With `land_fields` its level ground's albedo carries the
+/// fields' and woods' tint ([`terrain_albedo`]).
 pub fn terrain_radiance(
     p: Vec3,
     t: f32,
     dir: Vec3,
     sun_dir: Vec3,
+    spread: f32,
     h: &Heightfield,
     fr: &Frame,
 ) -> Vec3 {
     let d = &fr.density;
     let n = h.normal_at(p.x, p.z);
-    let slope = 1.0 - n.y;
-    let albedo = TERRAIN_ALBEDO_FLAT.lerp(TERRAIN_ALBEDO_STEEP, (slope * 3.0).min(1.0));
+    let albedo = terrain_albedo(p, n, ground_footprint(spread, t, dir.dot(n)), fr);
     let shadow = if fr.quality.shadow_steps > 0 && sun_dir.y > 0.0 {
         cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS, &fr.fields, d)
     } else {
@@ -356,6 +364,52 @@ pub fn terrain_radiance(
     let lit = albedo * (sun * (n.dot(sun_dir).max(0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
     let (inscatter, haze) = aerial(light, dir, t, sun_dir);
     lit * haze + inscatter
+}
+
+/// The terrain's albedo at `p` of normal `n`: level ground's
+/// [`TERRAIN_ALBEDO_FLAT`], times the land's tint over the plain land's
+/// when `land_fields` ([`land_albedo`] seen with a footprint
+/// `footprint_m` wide), toward [`TERRAIN_ALBEDO_STEEP`] as the slope
+/// `1 - n.y` grows to a third.
+pub fn terrain_albedo(p: Vec3, n: Vec3, footprint_m: f32, fr: &Frame) -> Vec3 {
+    let flat = if fr.quality.land_fields {
+        TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, true, fr.fields.cloud_map.noise())
+            / LAND_ALBEDO
+    } else {
+        TERRAIN_ALBEDO_FLAT
+    };
+    flat.lerp(TERRAIN_ALBEDO_STEEP, ((1.0 - n.y) * 3.0).min(1.0))
+}
+
+/// The width on the ground of a pixel of cone angle `spread` at distance
+/// `t`, its ray meeting the ground at cosine `cos` to the normal: the
+/// footprint's long axis, `spread · t / |cos|` (at most 20 times the
+/// short one, at grazing incidence).
+#[inline]
+pub fn ground_footprint(spread: f32, t: f32, cos: f32) -> f32 {
+    spread * t / cos.abs().max(0.05)
+}
+
+/// The flat ground's albedo where a ray of cone angle `spread` from
+/// `origin` along `dir` meets it (y = 0): the fields' [`land_albedo`]
+/// there when `land_fields`, else (or when the ray looks up, or the
+/// ground lies beyond `max_distance_m`) [`LAND_ALBEDO`].
+pub fn flat_ground_albedo(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Vec3 {
+    if !fr.quality.land_fields || dir.y >= 0.0 || origin.y <= 0.0 {
+        return LAND_ALBEDO;
+    }
+    let t = origin.y / -dir.y;
+    if t > fr.quality.max_distance_m {
+        return LAND_ALBEDO;
+    }
+    let (x, z) = (origin.x + dir.x * t, origin.z + dir.z * t);
+    land_albedo(
+        x,
+        z,
+        ground_footprint(spread, t, dir.y),
+        true,
+        fr.fields.cloud_map.noise(),
+    )
 }
 
 /// The clouds' shadow where a ray that meets no terrain reaches the flat

@@ -190,7 +190,7 @@ pub fn sky_ambient(sky: &SkyLight, sun_dir: Vec3) -> Vec3 {
 #[inline]
 pub fn sky_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
     if dir.y < 0.0 {
-        return land_radiance(sky, dir, sun_dir, 1.0);
+        return land_radiance(sky, dir, sun_dir, 1.0, LAND_ALBEDO);
     }
     sky_above(sky, dir, sun_dir)
 }
@@ -261,24 +261,25 @@ pub fn ground_haze_transmittance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Ve
 /// full sun read as a lawn from the air.
 pub const LAND_ALBEDO: Vec3 = Vec3::new(0.08, 0.10, 0.06);
 
-/// The flat land's own radiance (no haze): a Lambertian [`LAND_ALBEDO`]
-/// lit by the sun at the ground ([`sun_light_at`] times `sin(elevation)`,
-/// dimmed by the clouds' `shadow`, their transmittance toward the sun, 1:
-/// in the sun) and by the sky (the zenith's radiance standing for the
-/// sky's irradiance over π).
+/// The flat land's own radiance (no haze): Lambertian of `albedo`
+/// ([`LAND_ALBEDO`], or the fields' [`super::land::land_albedo`]) lit by
+/// the sun at the ground ([`sun_light_at`] times `sin(elevation)`, dimmed
+/// by the clouds' `shadow`, their transmittance toward the sun, 1: in the
+/// sun) and by the sky (the zenith's radiance standing for the sky's
+/// irradiance over π).
 #[inline]
-pub fn land_surface(sky: &SkyLight, sun_dir: Vec3, shadow: f32) -> Vec3 {
+pub fn land_surface(sky: &SkyLight, sun_dir: Vec3, shadow: f32, albedo: Vec3) -> Vec3 {
     let sun = sun_light_at(sky, 0.0, sun_dir);
     let lit = sun * (sun_dir.y.max(0.0) * shadow / PI) + sky_ambient(sky, sun_dir);
-    LAND_ALBEDO * lit
+    albedo * lit
 }
 
-/// The flat land seen along `dir` (pointing down): [`land_surface`] and
-/// the clouds' light on it (`sky.ground_cloud_light`) through the air
+/// The flat land of `albedo` seen along `dir` (pointing down):
+/// [`land_surface`] and the clouds' light on it (`sky.ground_cloud_light`) through the air
 /// ([`ground_haze`]).
 #[inline]
-pub fn land_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, shadow: f32) -> Vec3 {
-    let surface = land_surface(sky, sun_dir, shadow) + LAND_ALBEDO * sky.ground_cloud_light;
+pub fn land_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, shadow: f32, albedo: Vec3) -> Vec3 {
+    let surface = land_surface(sky, sun_dir, shadow, albedo) + albedo * sky.ground_cloud_light;
     ground_haze(sky, surface, dir, sun_dir)
 }
 
@@ -342,12 +343,26 @@ pub enum Surface {
     Sea,
 }
 
+/// What the land looks like from the air (`[render.ground] land`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Land {
+    /// A patchwork of fields in rows with woods across it
+    /// ([`super::land::land_albedo`]), its mean [`LAND_ALBEDO`].
+    #[default]
+    Fields,
+    /// One colour, [`LAND_ALBEDO`] (the path-traced comparisons' ground).
+    Plain,
+}
+
 /// The ground under the sky (scene table `[render.ground]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GroundConfig {
     /// `"land"` or `"sea"`. Default land.
     pub surface: Surface,
+    /// The land's look, `"fields"` or `"plain"`. Default fields.
+    pub land: Land,
     /// Wind speed over the sea, m/s (0..=30): the roughness of its waves,
     /// so the width of the sun's glint. Default 7.
     pub wind_speed_mps: f32,
@@ -357,6 +372,7 @@ impl Default for GroundConfig {
     fn default() -> Self {
         Self {
             surface: Surface::Land,
+            land: Land::Fields,
             wind_speed_mps: 7.0,
         }
     }
@@ -366,6 +382,12 @@ impl GroundConfig {
     /// The sea's wind speed when the ground is sea, else `None`.
     pub fn sea_wind_mps(&self) -> Option<f32> {
         (self.surface == Surface::Sea).then_some(self.wind_speed_mps)
+    }
+
+    /// Whether the land (flat or terrain) is drawn as fields and woods:
+    /// the ground is land and its look is [`Land::Fields`].
+    pub fn land_fields(&self) -> bool {
+        self.surface == Surface::Land && self.land == Land::Fields
     }
 }
 
@@ -454,13 +476,15 @@ pub fn ground_up(sky: &SkyLight, sun_dir: Vec3, sea: bool) -> Vec3 {
         let f = WATER_F0;
         return sky_above(sky, Vec3::Y, sun_dir) * f + water_light(sky, sun, sun_dir) * (1.0 - f);
     }
-    land_surface(sky, sun_dir, 1.0)
+    land_surface(sky, sun_dir, 1.0, LAND_ALBEDO)
 }
 
 /// What a ray that meets no terrain sees along `dir`: the sky and the sun
 /// disk, or below the horizon the land ([`land_radiance`]) or, with
 /// `sea_wind_mps`, the sea ([`sea_radiance`], mirroring the clouds of
-/// `reflection`), in the clouds' `shadow` where the ray meets them.
+/// `reflection`), in the clouds' `shadow` where the ray meets them; the
+/// land of albedo `land` there ([`LAND_ALBEDO`], or the fields'
+/// [`super::renderer::flat_ground_albedo`]).
 #[inline]
 pub fn background_radiance(
     sky: &SkyLight,
@@ -468,6 +492,7 @@ pub fn background_radiance(
     sun_dir: Vec3,
     sea_wind_mps: Option<f32>,
     shadow: f32,
+    land: Vec3,
     reflection: (Vec3, f32),
 ) -> Vec3 {
     if dir.y >= 0.0 {
@@ -475,7 +500,7 @@ pub fn background_radiance(
     }
     match sea_wind_mps {
         Some(wind) => sea_radiance(sky, dir, sun_dir, wind, shadow, reflection),
-        None => land_radiance(sky, dir, sun_dir, shadow),
+        None => land_radiance(sky, dir, sun_dir, shadow, land),
     }
 }
 

@@ -52,13 +52,13 @@ mod analytic {
         // cloud's shadow dims the glint.
         let up = Vec3::new(0.0, 0.5, 0.866);
         assert_eq!(
-            background_radiance(a, up, sun, Some(7.0), 0.0, NONE),
-            background_radiance(a, up, sun, None, 1.0, NONE)
+            background_radiance(a, up, sun, Some(7.0), 0.0, LAND_ALBEDO, NONE),
+            background_radiance(a, up, sun, None, 1.0, LAND_ALBEDO, NONE)
         );
         let d = Vec3::new(0.0, -0.5, 0.866);
         assert_ne!(
-            background_radiance(a, d, sun, Some(7.0), 1.0, NONE),
-            background_radiance(a, d, sun, None, 1.0, NONE)
+            background_radiance(a, d, sun, Some(7.0), 1.0, LAND_ALBEDO, NONE),
+            background_radiance(a, d, sun, None, 1.0, LAND_ALBEDO, NONE)
         );
         let g = -sun * Vec3::new(-1.0, 1.0, -1.0);
         let shaded = lum(sea_radiance(a, g, sun, 7.0, 0.1, NONE));
@@ -66,7 +66,10 @@ mod analytic {
         // The land in a cloud's shadow is darker by the sun's part, and
         // keeps the sky's: on a clear day the sky gives 10-30 % of the
         // irradiance on level ground at a 30° sun.
-        let (lit, dark) = (land_radiance(a, d, sun, 1.0), land_radiance(a, d, sun, 0.0));
+        let (lit, dark) = (
+            land_radiance(a, d, sun, 1.0, LAND_ALBEDO),
+            land_radiance(a, d, sun, 0.0, LAND_ALBEDO),
+        );
         let ratio = lum(dark) / lum(lit);
         assert!((0.1..0.3).contains(&ratio), "{ratio}");
     }

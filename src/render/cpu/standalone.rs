@@ -9,7 +9,7 @@ use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::renderer::Frame;
-use super::sky::{SkyLight, aerial, background_radiance, sun_direction};
+use super::sky::{LAND_ALBEDO, SkyLight, aerial, background_radiance, sun_direction};
 use crate::render::sampling::frame_offset;
 
 /// The sky a stand-alone pass draws under: the frame's, analytic, over
@@ -88,6 +88,7 @@ pub fn render_standalone(
                     sun_dir,
                     fr.quality.sea_wind_mps,
                     1.0,
+                    LAND_ALBEDO,
                     (Vec3::ZERO, 1.0),
                 );
                 *px = c.truncate() + (1.0 - c.w) * bg;

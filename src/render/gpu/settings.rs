@@ -58,6 +58,7 @@ impl GpuSettings {
             ("DETAIL", flag(self.detail())),
             ("DEBUG_COUNT", flag(self.debug_sample_count)),
             ("SEA", flag(self.quality.sea_wind_mps.is_some())),
+            ("LAND_FIELDS", flag(self.quality.land_fields)),
             (
                 "AERIAL_PERSPECTIVE",
                 flag(self.quality.atmosphere.aerial_perspective),

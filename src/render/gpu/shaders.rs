@@ -1,5 +1,6 @@
 //! WGSL sources, assembled per variant. `shaders/clouds.wgsl` holds the
-//! shared functions (the twins of `render::cpu`), then the sky model's
+//! shared functions (the twins of `render::cpu`), `shaders/land.wgsl`
+//! (the land's albedo), then the sky model's
 //! file (`sky_analytic.wgsl`, or `sky_luts.wgsl` and `sky_physical.wgsl`
 //! with the atmosphere tables' bindings); each pass appends its own file,
 //! and the variant's bindings and entry point are appended here, so a
@@ -24,6 +25,8 @@ pub const SKY_ANALYTIC: &str = include_str!("../../../shaders/sky_analytic.wgsl"
 /// The physical sky's functions and table bindings (after [`CLOUDS`] and
 /// [`SKY_LUTS`]).
 pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl");
+/// The land's albedo, plain or fields and woods (after [`CLOUDS`]).
+pub const LAND: &str = include_str!("../../../shaders/land.wgsl");
 
 /// The light volume's grid, read and coefficients (after [`CLOUDS`]; each
 /// module that appends it declares `diffusion_grid` and `light_cells`).
@@ -47,9 +50,9 @@ pub fn shared(physical: bool) -> String {
 
 fn sky_model(physical: bool) -> String {
     if physical {
-        format!("{CLOUDS}\n{SKY_LUTS}\n{SKY_PHYSICAL}\n")
+        format!("{CLOUDS}\n{LAND}\n{SKY_LUTS}\n{SKY_PHYSICAL}\n")
     } else {
-        format!("{CLOUDS}\n{SKY_ANALYTIC}\n")
+        format!("{CLOUDS}\n{LAND}\n{SKY_ANALYTIC}\n")
     }
 }
 

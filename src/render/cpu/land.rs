@@ -1,0 +1,275 @@
+//! The land's albedo where the ground is land (`[render.ground] land`):
+//! plain, one colour ([`LAND_ALBEDO`]), or fields, a patchwork of fields
+//! in rows with woods across it, whose mean over the land is that colour,
+//! so the light the ground sends up to the clouds and the sky's tables
+//! keep the plain land's albedo. Each function has a WGSL twin of the same
+//! name in `shaders/land.wgsl`.
+//!
+//! The woods are a threshold of the detail volume's base channel
+//! ([`crate::render::noise_volume`]) read on a horizontal slice at two
+//! scales, at the mip level of the pixel's footprint; the fields are
+//! parcels in rows, the rows of each farm (a block about 1.7 km across)
+//! on one of four headings, each row's fields of their own length, each
+//! parcel one of four crops by a hash of its cell. Where a pixel
+//! covers more than half a field's width the parcels fade to their mean,
+//! so the far land neither aliases nor shimmers.
+
+use glam::Vec3;
+
+use super::density::{NOISE_MAX_LOD, gained, lod_of};
+use super::sky::LAND_ALBEDO;
+use crate::render::noise_volume::{NoiseVolume, SIZE as NOISE_SIZE};
+
+/// The fields' length along their rows, m.
+pub const FIELD_LENGTH_M: f32 = 210.0;
+/// The rows' width (a field's width), m.
+pub const FIELD_WIDTH_M: f32 = 130.0;
+/// The rows' direction against the x (east) axis on the first of a
+/// farm's four headings, radians.
+pub const FIELD_ANGLE: f32 = 0.41;
+/// The turn between a farm's possible headings, radians (22°).
+pub const FARM_TURN: f32 = 0.39;
+/// A farm's size, m: a block whose fields share their rows' heading.
+pub const FARM_M: f32 = 1700.0;
+/// How far the farms' edges bend from straight lines, m.
+pub const FARM_BEND_M: f32 = 300.0;
+/// The woods' larger scale: the detail volume's tile, m.
+pub const WOODS_TILE_M: f32 = 7300.0;
+/// The woods' smaller scale, m (about a third of the larger, not a
+/// divisor of it, so the two tiles' pattern does not repeat soon).
+pub const WOODS_DETAIL_TILE_M: f32 = 2330.0;
+/// The two scales' noise, weighted, above which the land is wood: about
+/// 30 % of it (measured in the tests).
+pub const WOODS_THRESHOLD: f32 = 0.617;
+/// Half the width of the woods' edge in the noise's units.
+pub const WOODS_EDGE: f32 = 0.02;
+
+/// The four crops' albedo over the plain land's, before the
+/// normalisation ([`LAND_TINT_MEAN`]): grass, young crop, bare soil and
+/// stubble.
+const CROPS: [Vec3; 4] = [
+    Vec3::new(0.95, 1.10, 0.85),
+    Vec3::new(1.30, 1.25, 0.85),
+    Vec3::new(1.35, 0.95, 0.85),
+    Vec3::new(1.65, 1.35, 1.30),
+];
+/// The woods' albedo over the plain land's, before the normalisation.
+pub const WOODS: Vec3 = Vec3::new(0.45, 0.55, 0.45);
+/// The crops' mean.
+pub const CROPS_MEAN: Vec3 = Vec3::new(1.3125, 1.1625, 0.9625);
+/// The mean of the land's tint before the normalisation: 30 % woods, the
+/// rest the crops' mean; the tint is divided by it, so the land's mean
+/// albedo is [`LAND_ALBEDO`].
+pub const LAND_TINT_MEAN: Vec3 = Vec3::new(1.05375, 0.97875, 0.80875);
+
+/// A 32-bit integer hash of a field's cell (the rows' index `i`, the
+/// field's `j` along its row).
+#[inline]
+pub fn field_hash(i: i32, j: i32) -> u32 {
+    let mut h = (i as u32).wrapping_mul(0x8da6_b343) ^ (j as u32).wrapping_mul(0xd816_3841);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2c1b_3c6d);
+    h ^= h >> 12;
+    h = h.wrapping_mul(0x297a_2d39);
+    h ^ (h >> 15)
+}
+
+/// Crop `k`'s albedo over the plain land's (`k` modulo 4).
+#[inline]
+pub fn crop(k: u32) -> Vec3 {
+    CROPS[(k & 3) as usize]
+}
+
+/// The hash of the farm at world `(x, z)`: square blocks of [`FARM_M`],
+/// their edges bent by a few hundred metres, each with its own rows.
+#[inline]
+pub fn farm(x: f32, z: f32) -> u32 {
+    let bx = ((x + FARM_BEND_M * (z / 900.0).sin()) / FARM_M).floor() as i32;
+    let bz = ((z + FARM_BEND_M * (x / 1100.0).sin()) / FARM_M).floor() as i32;
+    field_hash(2 * bx + 1, 2 * bz)
+}
+
+/// The fields' tint at world `(x, z)`: the crop of the parcel there,
+/// brighter or darker by up to 12 %, faded to the crops' mean as the
+/// footprint `footprint_m` grows from half a field's width to a whole one.
+/// Each farm ([`farm`]) turns its rows by a multiple of [`FARM_TURN`];
+/// each row has its own fields' length (0.6 to 1.4 of
+/// [`FIELD_LENGTH_M`]) and start.
+#[inline]
+pub fn field_tint(x: f32, z: f32, footprint_m: f32) -> Vec3 {
+    let fade = (2.0 - 2.0 * footprint_m / FIELD_WIDTH_M).clamp(0.0, 1.0);
+    if fade <= 0.0 {
+        return CROPS_MEAN;
+    }
+    let b = farm(x, z);
+    let (s, c) = (FIELD_ANGLE + FARM_TURN * (b & 3) as f32).sin_cos();
+    let along = x * c + z * s;
+    let across = -x * s + z * c;
+    let row = (across / FIELD_WIDTH_M).floor() as i32;
+    let r = field_hash(row, (b >> 8) as i32);
+    let length = FIELD_LENGTH_M * (0.6 + 0.8 * ((r >> 12) & 255) as f32 / 255.0);
+    let field = (along / length + (r & 1023) as f32 / 1024.0).floor() as i32;
+    let h = field_hash(row, field) ^ b;
+    let shade = 1.0 + 0.24 * (((h >> 8) & 255) as f32 / 255.0 - 0.5);
+    CROPS_MEAN.lerp(crop(h) * shade, fade)
+}
+
+/// How much of the land at world `(x, z)` is wood, 0..1: the detail
+/// volume's base channel on a slice at two scales, at the mip level of
+/// the footprint, through a soft threshold.
+#[inline]
+pub fn woods_cover(x: f32, z: f32, footprint_m: f32, volume: &NoiseVolume) -> f32 {
+    let n = 0.65 * woods_noise(x, z, footprint_m, WOODS_TILE_M, 0.37, volume)
+        + 0.35 * woods_noise(x, z, footprint_m, WOODS_DETAIL_TILE_M, 0.71, volume);
+    smoothstep(
+        WOODS_THRESHOLD - WOODS_EDGE,
+        WOODS_THRESHOLD + WOODS_EDGE,
+        n,
+    )
+}
+
+/// One scale of the woods' noise: the detail volume's base channel at
+/// `(x / tile_m, y, z / tile_m)`, at the mip level of the footprint (at
+/// most [`NOISE_MAX_LOD`]), its spread restored ([`gained`]).
+#[inline]
+pub fn woods_noise(
+    x: f32,
+    z: f32,
+    footprint_m: f32,
+    tile_m: f32,
+    y: f32,
+    volume: &NoiseVolume,
+) -> f32 {
+    let lod = lod_of(footprint_m, tile_m / NOISE_SIZE as f32).min(NOISE_MAX_LOD);
+    gained(
+        volume.sample_level(Vec3::new(x / tile_m, y, z / tile_m), lod)[0],
+        lod,
+    )
+}
+
+/// The land's albedo at world `(x, z)` seen with a footprint
+/// `footprint_m` wide: [`LAND_ALBEDO`] when `fields` is off, else that
+/// times the woods' or the fields' tint over [`LAND_TINT_MEAN`].
+#[inline]
+pub fn land_albedo(x: f32, z: f32, footprint_m: f32, fields: bool, volume: &NoiseVolume) -> Vec3 {
+    if !fields {
+        return LAND_ALBEDO;
+    }
+    let woods = woods_cover(x, z, footprint_m, volume);
+    let tint = field_tint(x, z, footprint_m).lerp(WOODS, woods);
+    LAND_ALBEDO * tint / LAND_TINT_MEAN
+}
+
+#[inline]
+fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::cloud_map::CloudMap;
+
+    fn volume() -> std::sync::Arc<NoiseVolume> {
+        CloudMap::generate(&Default::default()).noise_shared()
+    }
+
+    /// The land's albedo at `n x n` points 97 m apart (not a divisor of
+    /// the fields' or the woods' scales) seen with `footprint_m`.
+    fn samples(n: usize, footprint_m: f32, v: &NoiseVolume) -> Vec<Vec3> {
+        (0..n * n)
+            .map(|k| {
+                let (x, z) = (
+                    (k % n) as f32 * 97.3 - 9000.0,
+                    (k / n) as f32 * 101.7 + 300.0,
+                );
+                land_albedo(x, z, footprint_m, true, v)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_fields_mean_albedo_is_the_plain_lands() {
+        // 400 x 400 points over 39 x 41 km: five of the woods' larger
+        // tiles each way, some 12,000 fields.
+        let v = volume();
+        let all = samples(400, 1.0, &v);
+        let mean = all.iter().sum::<Vec3>() / all.len() as f32;
+        let ratio = mean / LAND_ALBEDO;
+        assert!(
+            (ratio - Vec3::ONE).abs().max_element() < 0.03,
+            "mean over plain {ratio}"
+        );
+        // About 30 % of it is wood (the threshold's aim), and the rest
+        // varies from field to field.
+        let woods =
+            all.iter().filter(|a| a.y < 0.7 * LAND_ALBEDO.y).count() as f32 / all.len() as f32;
+        assert!((0.22..0.38).contains(&woods), "woods {woods}");
+        let spread = all.iter().map(|a| (a.x / mean.x - 1.0).abs()).sum::<f32>() / all.len() as f32;
+        assert!(spread > 0.15, "red channel's mean deviation {spread}");
+    }
+
+    #[test]
+    fn plain_land_is_one_colour() {
+        let v = volume();
+        for (x, z) in [(0.0, 0.0), (1234.5, -987.0), (55_000.0, 3.0)] {
+            assert_eq!(land_albedo(x, z, 1.0, false, &v), LAND_ALBEDO);
+        }
+    }
+
+    #[test]
+    fn fields_fade_to_their_mean_where_a_pixel_covers_them() {
+        // Up to half a field's width each parcel keeps its crop; from a
+        // whole width on, every point has the crops' mean; between, the
+        // spread around that mean falls.
+        let spread = |footprint_m: f32| {
+            (0..4000)
+                .map(|k| {
+                    let (x, z) = (k as f32 * 37.1, (k % 61) as f32 * 53.9);
+                    (field_tint(x, z, footprint_m) - CROPS_MEAN)
+                        .abs()
+                        .max_element()
+                })
+                .sum::<f32>()
+                / 4000.0
+        };
+        let (sharp, half, blurred) = (
+            spread(10.0),
+            spread(0.75 * FIELD_WIDTH_M),
+            spread(FIELD_WIDTH_M),
+        );
+        assert!(sharp > 0.15, "{sharp}");
+        assert!(
+            (half - 0.5 * sharp).abs() < 0.05 * sharp,
+            "{half} against {sharp}"
+        );
+        assert_eq!(blurred, 0.0);
+    }
+
+    #[test]
+    fn neighbouring_fields_differ() {
+        // Along a row, about two fields on: most change crop or shade.
+        let mut changed = 0;
+        for k in 0..400 {
+            let (x, z) = (k as f32 * 613.7, (k % 17) as f32 * 419.3);
+            let (s, c) = (FIELD_ANGLE + FARM_TURN * (farm(x, z) & 3) as f32).sin_cos();
+            let step = 1.5 * FIELD_LENGTH_M;
+            let (a, b) = (field_tint(x, z, 1.0), field_tint(x + step * c, z + step * s, 1.0));
+            changed += ((a - b).abs().max_element() > 0.01) as u32;
+        }
+        assert!(changed > 300, "{changed} of 400 neighbours differ");
+    }
+
+    #[test]
+    fn farms_turn_their_rows() {
+        // Over 40 km all four headings occur, none on more than a third
+        // of the farms.
+        let mut count = [0u32; 4];
+        for k in 0..2500 {
+            let (x, z) = ((k % 50) as f32 * 811.0, (k / 50) as f32 * 797.0);
+            count[(farm(x, z) & 3) as usize] += 1;
+        }
+        assert!(count.iter().all(|&n| (400..850).contains(&n)), "{count:?}");
+    }
+}
