@@ -28,6 +28,20 @@ fn ground_view(land: Land, scene: &str) -> Vec<Vec3> {
     render_linear(W, H, &fr)
 }
 
+/// The pixels' luminance ratios `fields / plain`, their mean and their
+/// standard deviation.
+fn luminance_ratios(fields: &[Vec3], plain: &[Vec3]) -> (Vec<f32>, f32, f32) {
+    let ratios: Vec<f32> = fields
+        .iter()
+        .zip(plain)
+        .map(|(f, p)| lum(*f) / lum(*p))
+        .collect();
+    let n = ratios.len() as f32;
+    let mean = ratios.iter().sum::<f32>() / n;
+    let spread = (ratios.iter().map(|r| (r - mean).powi(2)).sum::<f32>() / n).sqrt();
+    (ratios, mean, spread)
+}
+
 #[test]
 fn fields_vary_the_land_around_the_plain_lands_light() {
     let fields = ground_view(Land::Fields, "scenes/fair_weather.toml");
@@ -38,14 +52,7 @@ fn fields_vary_the_land_around_the_plain_lands_light() {
     // land's (woods about 0.55, stubble about 1.6). The mean over the land
     // is the plain land's (land.rs's tests); this view of a kilometre or
     // two has its own share of woods.
-    let ratios: Vec<f32> = fields
-        .iter()
-        .zip(&plain)
-        .map(|(f, p)| lum(*f) / lum(*p))
-        .collect();
-    let n = ratios.len() as f32;
-    let mean = ratios.iter().sum::<f32>() / n;
-    let spread = (ratios.iter().map(|r| (r - mean).powi(2)).sum::<f32>() / n).sqrt();
+    let (ratios, mean, spread) = luminance_ratios(&fields, &plain);
     assert!(
         spread > 0.12,
         "the ratio's spread {spread} (mean {mean}): the fields do not show"
@@ -92,14 +99,7 @@ fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
 fn the_terrains_level_ground_is_tinted_too() {
     let fields = ground_view(Land::Fields, "scenes/evening.toml");
     let plain = ground_view(Land::Plain, "scenes/evening.toml");
-    let ratios: Vec<f32> = fields
-        .iter()
-        .zip(&plain)
-        .map(|(f, p)| lum(*f) / lum(*p))
-        .collect();
-    let n = ratios.len() as f32;
-    let mean = ratios.iter().sum::<f32>() / n;
-    let spread = (ratios.iter().map(|r| (r - mean).powi(2)).sum::<f32>() / n).sqrt();
+    let (_, _, spread) = luminance_ratios(&fields, &plain);
     assert!(spread > 0.1, "the ratio's spread on the terrain {spread}");
 }
 

@@ -255,7 +255,10 @@ mod tests {
             let (x, z) = (k as f32 * 613.7, (k % 17) as f32 * 419.3);
             let (s, c) = (FIELD_ANGLE + FARM_TURN * (farm(x, z) & 3) as f32).sin_cos();
             let step = 1.5 * FIELD_LENGTH_M;
-            let (a, b) = (field_tint(x, z, 1.0), field_tint(x + step * c, z + step * s, 1.0));
+            let (a, b) = (
+                field_tint(x, z, 1.0),
+                field_tint(x + step * c, z + step * s, 1.0),
+            );
             changed += ((a - b).abs().max_element() > 0.01) as u32;
         }
         assert!(changed > 300, "{changed} of 400 neighbours differ");
