@@ -17,6 +17,14 @@ const WOODS_TILE_M: f32 = 7300.0;
 const WOODS_DETAIL_TILE_M: f32 = 2330.0;
 const WOODS_THRESHOLD: f32 = 0.617;
 const WOODS_EDGE: f32 = 0.02;
+const WOODS_SHARP_M: f32 = 40.0;
+const WOODS_SOFTEST: f32 = 5.0;
+const WOODS_FADE_M: f32 = 1000.0;
+const WOODS_SHARE: f32 = 0.3;
+const CROP_GRASS: vec3f = vec3f(0.95, 1.1, 0.85);
+const CROP_YOUNG: vec3f = vec3f(1.3, 1.25, 0.85);
+const CROP_SOIL: vec3f = vec3f(1.35, 0.95, 0.85);
+const CROP_STUBBLE: vec3f = vec3f(1.65, 1.35, 1.3);
 const WOODS: vec3f = vec3f(0.45, 0.55, 0.45);
 const CROPS_MEAN: vec3f = vec3f(1.3125, 1.1625, 0.9625);
 const LAND_TINT_MEAN: vec3f = vec3f(1.05375, 0.97875, 0.80875);
@@ -35,16 +43,16 @@ fn field_hash(i: i32, j: i32) -> u32 {
 fn crop(k: u32) -> vec3f {
     switch k & 3u {
         case 0u: {
-            return vec3f(0.95, 1.1, 0.85);
+            return CROP_GRASS;
         }
         case 1u: {
-            return vec3f(1.3, 1.25, 0.85);
+            return CROP_YOUNG;
         }
         case 2u: {
-            return vec3f(1.35, 0.95, 0.85);
+            return CROP_SOIL;
         }
         default: {
-            return vec3f(1.65, 1.35, 1.3);
+            return CROP_STUBBLE;
         }
     }
 }
@@ -85,23 +93,26 @@ fn woods_noise(x: f32, z: f32, footprint_m: f32, tile_m: f32, y: f32) -> f32 {
 
 // How much of the land at (x, z) is wood (the CPU's `woods_cover`).
 fn woods_cover(x: f32, z: f32, footprint_m: f32) -> f32 {
+    let fade = clamp(footprint_m / WOODS_FADE_M - 1.0, 0.0, 1.0);
+    if fade >= 1.0 {
+        return WOODS_SHARE;
+    }
     let n = 0.65 * woods_noise(x, z, footprint_m, WOODS_TILE_M, 0.37)
         + 0.35 * woods_noise(x, z, footprint_m, WOODS_DETAIL_TILE_M, 0.71);
-    return smoothstep(WOODS_THRESHOLD - WOODS_EDGE, WOODS_THRESHOLD + WOODS_EDGE, n);
+    let edge = WOODS_EDGE * clamp(footprint_m / WOODS_SHARP_M, 1.0, WOODS_SOFTEST);
+    let cover = smoothstep(WOODS_THRESHOLD - edge, WOODS_THRESHOLD + edge, n);
+    return cover + (WOODS_SHARE - cover) * fade;
 }
 
 // The land's albedo at (x, z) (the CPU's `land_albedo`).
-fn land_albedo(x: f32, z: f32, footprint_m: f32, fields: bool) -> vec3f {
-    if !fields {
-        return LAND_ALBEDO;
-    }
+fn land_albedo(x: f32, z: f32, footprint_m: f32) -> vec3f {
     let tint = mix(field_tint(x, z, footprint_m), WOODS, woods_cover(x, z, footprint_m));
     return LAND_ALBEDO * tint / LAND_TINT_MEAN;
 }
 
 // A pixel's width on the ground (the CPU's `ground_footprint`).
-fn ground_footprint(spread: f32, t: f32, cos: f32) -> f32 {
-    return spread * t / max(abs(cos), 0.05);
+fn ground_footprint(spread: f32, t: f32, cos_n: f32) -> f32 {
+    return spread * t / max(abs(cos_n), 0.05);
 }
 
 // The flat ground's albedo where the ray meets it (the CPU's
@@ -116,5 +127,7 @@ fn flat_ground_albedo(origin: vec3f, dir: vec3f, spread: f32) -> vec3f {
     }
     let x = origin.x + dir.x * t;
     let z = origin.z + dir.z * t;
-    return land_albedo(x, z, ground_footprint(spread, t, dir.y), true);
+    let land = land_albedo(x, z, ground_footprint(spread, t, dir.y));
+    let far = clamp(4.0 * t / frame.sun_light.w - 3.0, 0.0, 1.0);
+    return mix(land, LAND_ALBEDO, far);
 }

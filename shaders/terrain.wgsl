@@ -44,17 +44,18 @@ const TERRAIN_ALBEDO_STEEP: vec3f = vec3f(0.16, 0.13, 0.09);
 
 // The terrain's albedo, tinted by the fields and woods when LAND_FIELDS
 // (the CPU's `terrain_albedo`).
-fn terrain_albedo(p: vec3f, n: vec3f, footprint_m: f32) -> vec3f {
+fn terrain_albedo(p: vec3f, n: vec3f, dir: vec3f, t: f32) -> vec3f {
     var flat = TERRAIN_ALBEDO_FLAT;
     if LAND_FIELDS {
-        flat = TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, true) / LAND_ALBEDO;
+        let footprint_m = ground_footprint(frame.cam_pos.w, t, dot(dir, n));
+        flat = TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m) / LAND_ALBEDO;
     }
     return mix(flat, TERRAIN_ALBEDO_STEEP, min((1.0 - n.y) * 3.0, 1.0));
 }
 
 fn terrain_radiance(p: vec3f, t: f32, dir: vec3f, sun_dir: vec3f) -> vec3f {
     let n = normal_at(p.x, p.z);
-    let albedo = terrain_albedo(p, n, ground_footprint(frame.cam_pos.w, t, dot(dir, n)));
+    let albedo = terrain_albedo(p, n, dir, t);
     var shadow = 1.0;
     if SHADOW_STEPS > 0u && sun_dir.y > 0.0 {
         shadow = cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS);

@@ -64,7 +64,8 @@ fn fields_vary_the_land_around_the_plain_lands_light() {
 
 #[test]
 fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
-    use cumulus::render::cpu::renderer::{flat_ground_albedo, flat_ground_shadow};
+    use cumulus::render::cpu::land::land_albedo;
+    use cumulus::render::cpu::renderer::{Quality, flat_ground_albedo, flat_ground_shadow};
     use cumulus::render::cpu::sky::{LAND_ALBEDO, background_radiance, sun_direction};
     let mut sc = Scene::load(std::path::Path::new("scenes/fair_weather.toml")).expect("scene");
     sc.render.camera_position_m = [5000.0, 400.0, 5000.0];
@@ -79,6 +80,19 @@ fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
         let a = k as f32 * 0.37;
         let dir = Vec3::new(a.cos(), -0.25 - 0.01 * (k % 7) as f32, a.sin()).normalize();
         let albedo = flat_ground_albedo(origin, dir, spread, &fr);
+        // The land where this ray meets the ground, found here.
+        let t = origin.y / -dir.y;
+        let hit = origin + dir * t;
+        let own = land_albedo(
+            hit.x,
+            hit.z,
+            spread * t / -dir.y,
+            fr.fields.cloud_map.noise(),
+        );
+        assert!(
+            (albedo - own).abs().max_element() < 1e-6,
+            "{albedo} against {own}"
+        );
         let sky = fr.sky_light();
         let shadow = flat_ground_shadow(origin, dir, sun, &fr);
         let expected = background_radiance(&sky, dir, sun, None, shadow, albedo, (Vec3::ZERO, 1.0));
@@ -92,6 +106,25 @@ fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
     assert!(
         differs > 40,
         "{differs} of 64 points off the plain land's albedo"
+    );
+    // Near the rays' end the land fades to the plain land's colour, so
+    // it has no seam where the rays stop; plain land is that colour.
+    let max_d = fr.quality.max_distance_m;
+    let dir = Vec3::new(1.0, -400.0 / (0.995 * max_d), 0.0).normalize();
+    let far = flat_ground_albedo(origin, dir, spread, &fr);
+    assert!(
+        (far - LAND_ALBEDO).abs().max_element() < 0.03 * LAND_ALBEDO.max_element(),
+        "{far}"
+    );
+    let q = Quality {
+        land_fields: false,
+        ..sc.render.quality()
+    };
+    let plain = p.frame(&sc.render, q);
+    let down = Vec3::new(0.3, -0.5, 0.2).normalize();
+    assert_eq!(
+        flat_ground_albedo(origin, down, spread, &plain),
+        LAND_ALBEDO
     );
 }
 

@@ -145,7 +145,8 @@ fn gpu_matches_cpu_reference_over_the_sea() {
 /// The fields and woods (`[render.ground] land`, on by default) seen from
 /// 400 m looking 35° down, parcels a few pixels wide near the bottom and
 /// faded to their mean toward the horizon: the composite's
-/// `flat_ground_albedo` against the CPU's.
+/// `flat_ground_albedo` against the CPU's, with the detail noise and
+/// without it.
 #[test]
 fn gpu_matches_cpu_reference_on_the_fields() {
     let Some(ctx) = gpu() else { return };
@@ -153,6 +154,16 @@ fn gpu_matches_cpu_reference_on_the_fields() {
     assert!(sc.render.quality().land_fields, "fields by default");
     sc.render.camera_position_m = [5000.0, 400.0, 5000.0];
     sc.render.camera_pitch_deg = -35.0;
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    ); // Without the detail noise the woods still read the detail volume:
+    // it is uploaded for them.
+    sc.render.detail_strength = 0.0;
     parity(
         &ctx,
         &sc,
@@ -279,9 +290,14 @@ fn each_scene_builds_only_the_passes_it_needs() {
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     assert!(!hl.renderer.textures().iter().any(|n| n.starts_with("tsaa")));
 
-    // The detail volume exists only while the detail is on.
+    // The detail volume exists only while the detail noise or the land's
+    // woods read it.
     assert!(hl.renderer.textures().contains(&"clouds.detail_volume"));
     s.density.detail_strength = 0.0;
+    hl.renderer.set_settings(&s);
+    hl.render(&ctx, &r.camera(), 1).expect("frame");
+    assert!(hl.renderer.textures().contains(&"clouds.detail_volume"));
+    s.quality.land_fields = false;
     hl.renderer.set_settings(&s);
     hl.render(&ctx, &r.camera(), 1).expect("frame");
     assert!(!hl.renderer.textures().contains(&"clouds.detail_volume"));

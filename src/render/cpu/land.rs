@@ -11,8 +11,11 @@
 //! parcels in rows, the rows of each farm (a block about 1.7 km across)
 //! on one of four headings, each row's fields of their own length, each
 //! parcel one of four crops by a hash of its cell. Where a pixel
-//! covers more than half a field's width the parcels fade to their mean,
-//! so the far land neither aliases nor shimmers.
+//! covers more than half a field's width the parcels fade to their mean;
+//! the woods' edges soften as the footprint grows past 40 m, and from a
+//! footprint of 1 km to 2 km the woods fade to their share of the land,
+//! so the far land neither aliases nor shimmers, and is the plain land's
+//! colour where no pattern can be resolved.
 
 use glam::Vec3;
 
@@ -41,24 +44,37 @@ pub const WOODS_DETAIL_TILE_M: f32 = 2330.0;
 /// The two scales' noise, weighted, above which the land is wood: about
 /// 30 % of it (measured in the tests).
 pub const WOODS_THRESHOLD: f32 = 0.617;
-/// Half the width of the woods' edge in the noise's units.
+/// Half the width of the woods' edge in the noise's units, up to a
+/// footprint of [`WOODS_SHARP_M`]; wider in proportion beyond.
 pub const WOODS_EDGE: f32 = 0.02;
+/// The footprint up to which the woods' edge is sharpest, m: about the
+/// smaller tile's texel (36 m).
+pub const WOODS_SHARP_M: f32 = 40.0;
+/// The widest the woods' edge grows, in units of [`WOODS_EDGE`]: wider,
+/// the threshold's soft ramp would shift the woods' share (measured: 42 %
+/// at a footprint of 1.5 km with no cap).
+pub const WOODS_SOFTEST: f32 = 5.0;
+/// The footprint from which the woods fade to [`WOODS_SHARE`], fully at
+/// twice it, m.
+pub const WOODS_FADE_M: f32 = 1000.0;
+/// The share of the land that is wood, what the woods fade to.
+pub const WOODS_SHARE: f32 = 0.3;
 
-/// The four crops' albedo over the plain land's, before the
-/// normalisation ([`LAND_TINT_MEAN`]): grass, young crop, bare soil and
-/// stubble.
-const CROPS: [Vec3; 4] = [
-    Vec3::new(0.95, 1.10, 0.85),
-    Vec3::new(1.30, 1.25, 0.85),
-    Vec3::new(1.35, 0.95, 0.85),
-    Vec3::new(1.65, 1.35, 1.30),
-];
+/// Grass's albedo over the plain land's, before the normalisation
+/// ([`LAND_TINT_MEAN`]).
+pub const CROP_GRASS: Vec3 = Vec3::new(0.95, 1.10, 0.85);
+/// A young crop's.
+pub const CROP_YOUNG: Vec3 = Vec3::new(1.30, 1.25, 0.85);
+/// Bare soil's.
+pub const CROP_SOIL: Vec3 = Vec3::new(1.35, 0.95, 0.85);
+/// Stubble's.
+pub const CROP_STUBBLE: Vec3 = Vec3::new(1.65, 1.35, 1.30);
 /// The woods' albedo over the plain land's, before the normalisation.
 pub const WOODS: Vec3 = Vec3::new(0.45, 0.55, 0.45);
 /// The crops' mean.
 pub const CROPS_MEAN: Vec3 = Vec3::new(1.3125, 1.1625, 0.9625);
-/// The mean of the land's tint before the normalisation: 30 % woods, the
-/// rest the crops' mean; the tint is divided by it, so the land's mean
+/// The mean of the land's tint before the normalisation: [`WOODS_SHARE`]
+/// woods, the rest the crops' mean; the tint is divided by it, so the land's mean
 /// albedo is [`LAND_ALBEDO`].
 pub const LAND_TINT_MEAN: Vec3 = Vec3::new(1.05375, 0.97875, 0.80875);
 
@@ -77,7 +93,12 @@ pub fn field_hash(i: i32, j: i32) -> u32 {
 /// Crop `k`'s albedo over the plain land's (`k` modulo 4).
 #[inline]
 pub fn crop(k: u32) -> Vec3 {
-    CROPS[(k & 3) as usize]
+    match k & 3 {
+        0 => CROP_GRASS,
+        1 => CROP_YOUNG,
+        2 => CROP_SOIL,
+        _ => CROP_STUBBLE,
+    }
 }
 
 /// The hash of the farm at world `(x, z)`: square blocks of [`FARM_M`],
@@ -116,16 +137,21 @@ pub fn field_tint(x: f32, z: f32, footprint_m: f32) -> Vec3 {
 
 /// How much of the land at world `(x, z)` is wood, 0..1: the detail
 /// volume's base channel on a slice at two scales, at the mip level of
-/// the footprint, through a soft threshold.
+/// the footprint, through a threshold whose edge widens with the
+/// footprint beyond [`WOODS_SHARP_M`] (at most [`WOODS_SOFTEST`] times
+/// as wide), faded to [`WOODS_SHARE`] as the
+/// footprint grows from [`WOODS_FADE_M`] to twice it.
 #[inline]
 pub fn woods_cover(x: f32, z: f32, footprint_m: f32, volume: &NoiseVolume) -> f32 {
+    let fade = (footprint_m / WOODS_FADE_M - 1.0).clamp(0.0, 1.0);
+    if fade >= 1.0 {
+        return WOODS_SHARE;
+    }
     let n = 0.65 * woods_noise(x, z, footprint_m, WOODS_TILE_M, 0.37, volume)
         + 0.35 * woods_noise(x, z, footprint_m, WOODS_DETAIL_TILE_M, 0.71, volume);
-    smoothstep(
-        WOODS_THRESHOLD - WOODS_EDGE,
-        WOODS_THRESHOLD + WOODS_EDGE,
-        n,
-    )
+    let edge = WOODS_EDGE * (footprint_m / WOODS_SHARP_M).clamp(1.0, WOODS_SOFTEST);
+    let cover = smoothstep(WOODS_THRESHOLD - edge, WOODS_THRESHOLD + edge, n);
+    cover + (WOODS_SHARE - cover) * fade
 }
 
 /// One scale of the woods' noise: the detail volume's base channel at
@@ -147,14 +173,12 @@ pub fn woods_noise(
     )
 }
 
-/// The land's albedo at world `(x, z)` seen with a footprint
-/// `footprint_m` wide: [`LAND_ALBEDO`] when `fields` is off, else that
-/// times the woods' or the fields' tint over [`LAND_TINT_MEAN`].
+/// The fields' land's albedo at world `(x, z)` seen with a footprint
+/// `footprint_m` wide: [`LAND_ALBEDO`] times the woods' or the fields'
+/// tint over [`LAND_TINT_MEAN`] (the plain land's is [`LAND_ALBEDO`]
+/// itself; the callers choose).
 #[inline]
-pub fn land_albedo(x: f32, z: f32, footprint_m: f32, fields: bool, volume: &NoiseVolume) -> Vec3 {
-    if !fields {
-        return LAND_ALBEDO;
-    }
+pub fn land_albedo(x: f32, z: f32, footprint_m: f32, volume: &NoiseVolume) -> Vec3 {
     let woods = woods_cover(x, z, footprint_m, volume);
     let tint = field_tint(x, z, footprint_m).lerp(WOODS, woods);
     LAND_ALBEDO * tint / LAND_TINT_MEAN
@@ -184,9 +208,13 @@ mod tests {
                     (k % n) as f32 * 97.3 - 9000.0,
                     (k / n) as f32 * 101.7 + 300.0,
                 );
-                land_albedo(x, z, footprint_m, true, v)
+                land_albedo(x, z, footprint_m, v)
             })
             .collect()
+    }
+
+    fn mean_of(all: &[Vec3]) -> Vec3 {
+        all.iter().sum::<Vec3>() / all.len() as f32
     }
 
     #[test]
@@ -195,12 +223,25 @@ mod tests {
         // tiles each way, some 12,000 fields.
         let v = volume();
         let all = samples(400, 1.0, &v);
-        let mean = all.iter().sum::<Vec3>() / all.len() as f32;
+        let mean = mean_of(&all);
         let ratio = mean / LAND_ALBEDO;
         assert!(
             (ratio - Vec3::ONE).abs().max_element() < 0.03,
             "mean over plain {ratio}"
         );
+        // Seen from afar too: fields faded, woods at a coarse mip level
+        // with soft edges (200 m, 600 m), half faded (1.5 km), and where
+        // nothing is resolved, the plain land itself (2 km).
+        for footprint_m in [200.0, 600.0, 1500.0] {
+            let r = mean_of(&samples(200, footprint_m, &v)) / LAND_ALBEDO;
+            assert!(
+                (r - Vec3::ONE).abs().max_element() < 0.05,
+                "{footprint_m} m: {r}"
+            );
+        }
+        for a in samples(20, 2000.0, &v) {
+            assert!((a - LAND_ALBEDO).abs().max_element() < 1e-6, "{a}");
+        }
         // About 30 % of it is wood (the threshold's aim), and the rest
         // varies from field to field.
         let woods =
@@ -208,14 +249,6 @@ mod tests {
         assert!((0.22..0.38).contains(&woods), "woods {woods}");
         let spread = all.iter().map(|a| (a.x / mean.x - 1.0).abs()).sum::<f32>() / all.len() as f32;
         assert!(spread > 0.15, "red channel's mean deviation {spread}");
-    }
-
-    #[test]
-    fn plain_land_is_one_colour() {
-        let v = volume();
-        for (x, z) in [(0.0, 0.0), (1234.5, -987.0), (55_000.0, 3.0)] {
-            assert_eq!(land_albedo(x, z, 1.0, false, &v), LAND_ALBEDO);
-        }
     }
 
     #[test]

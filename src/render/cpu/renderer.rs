@@ -352,7 +352,7 @@ pub fn terrain_radiance(
 ) -> Vec3 {
     let d = &fr.density;
     let n = h.normal_at(p.x, p.z);
-    let albedo = terrain_albedo(p, n, ground_footprint(spread, t, dir.dot(n)), fr);
+    let albedo = terrain_albedo(p, n, dir, t, spread, fr);
     let shadow = if fr.quality.shadow_steps > 0 && sun_dir.y > 0.0 {
         cloud_shadow(p, sun_dir, GROUND_SHADOW_STEPS, &fr.fields, d)
     } else {
@@ -366,14 +366,16 @@ pub fn terrain_radiance(
     lit * haze + inscatter
 }
 
-/// The terrain's albedo at `p` of normal `n`: level ground's
+/// The terrain's albedo at `p` of normal `n` (seen along `dir` from `t`
+/// away by a pixel of cone angle `spread`): level ground's
 /// [`TERRAIN_ALBEDO_FLAT`], times the land's tint over the plain land's
-/// when `land_fields` ([`land_albedo`] seen with a footprint
-/// `footprint_m` wide), toward [`TERRAIN_ALBEDO_STEEP`] as the slope
+/// when `land_fields` ([`land_albedo`] seen with the pixel's
+/// [`ground_footprint`]), toward [`TERRAIN_ALBEDO_STEEP`] as the slope
 /// `1 - n.y` grows to a third.
-pub fn terrain_albedo(p: Vec3, n: Vec3, footprint_m: f32, fr: &Frame) -> Vec3 {
+pub fn terrain_albedo(p: Vec3, n: Vec3, dir: Vec3, t: f32, spread: f32, fr: &Frame) -> Vec3 {
     let flat = if fr.quality.land_fields {
-        TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, true, fr.fields.cloud_map.noise())
+        let footprint_m = ground_footprint(spread, t, dir.dot(n));
+        TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, fr.fields.cloud_map.noise())
             / LAND_ALBEDO
     } else {
         TERRAIN_ALBEDO_FLAT
@@ -382,18 +384,20 @@ pub fn terrain_albedo(p: Vec3, n: Vec3, footprint_m: f32, fr: &Frame) -> Vec3 {
 }
 
 /// The width on the ground of a pixel of cone angle `spread` at distance
-/// `t`, its ray meeting the ground at cosine `cos` to the normal: the
-/// footprint's long axis, `spread · t / |cos|` (at most 20 times the
+/// `t`, its ray meeting the ground at cosine `cos_n` to the normal: the
+/// footprint's long axis, `spread · t / |cos_n|` (at most 20 times the
 /// short one, at grazing incidence).
 #[inline]
-pub fn ground_footprint(spread: f32, t: f32, cos: f32) -> f32 {
-    spread * t / cos.abs().max(0.05)
+pub fn ground_footprint(spread: f32, t: f32, cos_n: f32) -> f32 {
+    spread * t / cos_n.abs().max(0.05)
 }
 
 /// The flat ground's albedo where a ray of cone angle `spread` from
 /// `origin` along `dir` meets it (y = 0): the fields' [`land_albedo`]
-/// there when `land_fields`, else (or when the ray looks up, or the
-/// ground lies beyond `max_distance_m`) [`LAND_ALBEDO`].
+/// there when `land_fields`, faded to [`LAND_ALBEDO`] over the last
+/// quarter of `max_distance_m` (where the rays stop, so the land seen
+/// further has no seam); [`LAND_ALBEDO`] when off, when the ray looks
+/// up, or beyond `max_distance_m`.
 pub fn flat_ground_albedo(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Vec3 {
     if !fr.quality.land_fields || dir.y >= 0.0 || origin.y <= 0.0 {
         return LAND_ALBEDO;
@@ -403,13 +407,14 @@ pub fn flat_ground_albedo(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> V
         return LAND_ALBEDO;
     }
     let (x, z) = (origin.x + dir.x * t, origin.z + dir.z * t);
-    land_albedo(
+    let land = land_albedo(
         x,
         z,
         ground_footprint(spread, t, dir.y),
-        true,
         fr.fields.cloud_map.noise(),
-    )
+    );
+    let far = (4.0 * t / fr.quality.max_distance_m - 3.0).clamp(0.0, 1.0);
+    land.lerp(LAND_ALBEDO, far)
 }
 
 /// The clouds' shadow where a ray that meets no terrain reaches the flat

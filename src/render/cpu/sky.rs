@@ -255,7 +255,8 @@ pub fn ground_haze_transmittance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Ve
     }
 }
 
-/// The flat land's albedo (inlined in WGSL's `land_radiance`): a muted
+/// The flat land's albedo (`LAND_ALBEDO` in WGSL), the plain land's and
+/// the fields' mean ([`super::land`]): a muted
 /// green-brown of fields, woods and soil seen from afar, greyer than the
 /// terrain's grass (0.07 / 0.11 / 0.04 on level ground), which lit at
 /// full sun read as a lawn from the air.

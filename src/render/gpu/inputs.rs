@@ -45,7 +45,7 @@ pub struct Inputs {
 
 impl Inputs {
     /// The inputs with `cloud_map` uploaded (its detail volume only with
-    /// `detail`), an empty P (clear sky), and with `sky` the physical
+    /// `detail`: the detail noise or the land's woods read it), an empty P (clear sky), and with `sky` the physical
     /// sky's tables for the sun at `sun_dir` (the sky view for a camera on
     /// the ground until the first frame).
     pub fn new(
@@ -182,7 +182,8 @@ impl Inputs {
         self.rebind(device);
     }
 
-    /// Uploads the detail volume (`on`) or drops it for a stand-in.
+    /// Uploads the detail volume (`on`: the detail noise or the land's
+    /// woods read it) or drops it for a stand-in.
     pub fn set_detail(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, on: bool) {
         if on == self.detail {
             return;

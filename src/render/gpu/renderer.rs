@@ -168,7 +168,7 @@ impl CloudRenderer {
             device,
             queue,
             cloud_map,
-            settings.detail(),
+            settings.noise_volume(),
             sky.as_ref(),
             settings.sun_dir(),
         );
@@ -264,7 +264,7 @@ impl CloudRenderer {
             t.settings = s;
         }
         self.inputs
-            .set_detail(&self.device, &queue, settings.detail());
+            .set_detail(&self.device, &queue, settings.noise_volume());
         self.set_light(&old, constants_changed);
         if constants_changed && let Some(t) = &mut self.terrain {
             t.rebuild_pipeline(&self.device, &self.inputs, &constants);

@@ -32,6 +32,13 @@ impl GpuSettings {
         self.density.detail_strength > 0.0
     }
 
+    /// Whether the detail volume is uploaded: the detail noise reads it,
+    /// and so do the land's woods ([`crate::render::cpu::land`]); with
+    /// neither, a 1³ stand-in is bound.
+    pub fn noise_volume(&self) -> bool {
+        self.detail() || self.quality.land_fields
+    }
+
     /// Whether the light volume exists: with multiple scattering on
     /// (`octaves > 0`), as on the CPU ([`crate::prepare::Prepared::frame`]).
     pub fn light_volume(&self) -> bool {
@@ -48,8 +55,9 @@ impl GpuSettings {
         sun_direction(self.sun_elevation_deg, self.sun_azimuth_deg)
     }
 
-    /// Values of the WGSL `override` constants (`shaders/clouds.wgsl`) for
-    /// these settings: a feature that is off is compiled out.
+    /// Values of the WGSL `override` constants (`shaders/clouds.wgsl`, and
+    /// `LAND_FIELDS` in `shaders/land.wgsl`) for these settings: a feature
+    /// that is off is compiled out.
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         vec![

@@ -134,7 +134,8 @@ pub fn upload_cloud_map(
 }
 
 /// Uploads the 3D detail volume and its mips (`Rg8Unorm`, filterable),
-/// or, without `v` (the detail is off), a 1³ stand-in that no shader
+/// or, without `v` (neither the detail noise nor the land's woods read
+/// it, `GpuSettings::noise_volume`), a 1³ stand-in that no shader
 /// variant reads, so the binding exists but the volume does not.
 pub fn upload_noise_volume(
     device: &wgpu::Device,
