@@ -4,7 +4,7 @@
 //! like any other. (Kept in the library, without egui, so the round trip
 //! is tested.)
 
-use crate::render::cpu::sky::SkyModel;
+use crate::render::cpu::sky::{Land, SkyModel};
 use crate::scene::Scene;
 use crate::sim::Band;
 
@@ -38,6 +38,8 @@ pub struct PanelState {
     pub octaves: u32,
     /// The terrain.
     pub terrain: bool,
+    /// The land as fields and woods (off: plain; `[render.ground] land`).
+    pub fields: bool,
     /// The physical sky (off: the analytic one).
     pub physical_sky: bool,
     /// The physical sky's aerosol optical depth, 0..=3.
@@ -62,6 +64,7 @@ impl PanelState {
             shadow_steps: r.shadow_steps,
             octaves: r.octaves,
             terrain: r.terrain.enabled,
+            fields: r.ground.land == Land::Fields,
             physical_sky: r.atmosphere.model == SkyModel::Physical,
             aerosol_optical_depth: r.atmosphere.aerosol_optical_depth,
         }
@@ -78,6 +81,11 @@ impl PanelState {
         r.shadow_steps = self.shadow_steps;
         r.octaves = self.octaves;
         r.terrain.enabled = self.terrain;
+        r.ground.land = if self.fields {
+            Land::Fields
+        } else {
+            Land::Plain
+        };
         r.atmosphere.model = if self.physical_sky {
             SkyModel::Physical
         } else {

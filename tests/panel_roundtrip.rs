@@ -23,6 +23,7 @@ fn roundtrip(name: &str) {
     panel.shadow_steps = 3;
     panel.octaves = 1;
     panel.terrain = !panel.terrain;
+    panel.fields = !panel.fields;
     panel.physical_sky = !panel.physical_sky;
     panel.aerosol_optical_depth = 0.42;
     panel.apply(&mut scene);

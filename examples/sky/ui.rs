@@ -154,6 +154,9 @@ pub fn panel(
         ch |= unit_slider(ui, &mut p.shadow_steps, 0..=32, "shadow steps (0: off)");
         ch |= unit_slider(ui, &mut p.octaves, 0..=3, "scattering octaves");
         ch |= ui.checkbox(&mut p.terrain, "terrain").changed();
+        ch |= ui
+            .checkbox(&mut p.fields, "fields and woods (off: plain land)")
+            .changed();
         a.panel_changed = ch;
         ui.separator();
         ui.label("Camera (drag: look/orbit, WASD/QE: fly, Shift: fast, wheel: speed/zoom)");
