@@ -38,12 +38,12 @@ fn normal_at(x: f32, z: f32) -> vec3f {
 }
 
 // The terrain's albedo flat and from a slope of a third (the CPU's
-// renderer.rs).
+// land.rs).
 const TERRAIN_ALBEDO_FLAT: vec3f = vec3f(0.07, 0.11, 0.04);
 const TERRAIN_ALBEDO_STEEP: vec3f = vec3f(0.16, 0.13, 0.09);
 
 // The terrain's albedo, tinted by the fields and woods when LAND_FIELDS
-// (the CPU's `terrain_albedo`).
+// (the CPU's `land::terrain_albedo`).
 fn terrain_albedo(p: vec3f, n: vec3f, dir: vec3f, t: f32) -> vec3f {
     var flat = TERRAIN_ALBEDO_FLAT;
     if LAND_FIELDS {

@@ -9,8 +9,9 @@ mod common;
 use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::View;
+use cumulus::render::cpu::land::flat_ground_albedo;
 use cumulus::render::cpu::renderer::{
-    flat_ground_albedo, flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
+    flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
 };
 use cumulus::render::cpu::sea::sea_reflection;
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};

@@ -64,8 +64,8 @@ fn fields_vary_the_land_around_the_plain_lands_light() {
 
 #[test]
 fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
-    use cumulus::render::cpu::land::land_albedo;
-    use cumulus::render::cpu::renderer::{Quality, flat_ground_albedo, flat_ground_shadow};
+    use cumulus::render::cpu::land::{flat_ground_albedo, land_albedo};
+    use cumulus::render::cpu::renderer::{Quality, flat_ground_shadow};
     use cumulus::render::cpu::sky::{LAND_ALBEDO, background_radiance, sun_direction};
     let mut sc = Scene::load(std::path::Path::new("scenes/fair_weather.toml")).expect("scene");
     sc.render.camera_position_m = [5000.0, 400.0, 5000.0];

@@ -305,8 +305,8 @@ fn every_wgsl_constant_equals_its_rust_twin() {
 fn rust_vectors() -> Vec<(&'static str, glam::Vec3)> {
     vec![
         ("LAND_ALBEDO", sky::LAND_ALBEDO),
-        ("TERRAIN_ALBEDO_FLAT", renderer::TERRAIN_ALBEDO_FLAT),
-        ("TERRAIN_ALBEDO_STEEP", renderer::TERRAIN_ALBEDO_STEEP),
+        ("TERRAIN_ALBEDO_FLAT", land::TERRAIN_ALBEDO_FLAT),
+        ("TERRAIN_ALBEDO_STEEP", land::TERRAIN_ALBEDO_STEEP),
         ("WOODS", land::WOODS),
         ("CROP_GRASS", land::CROP_GRASS),
         ("CROP_YOUNG", land::CROP_YOUNG),

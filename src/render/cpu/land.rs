@@ -2,8 +2,10 @@
 //! plain, one colour ([`LAND_ALBEDO`]), or fields, a patchwork of fields
 //! in rows with woods across it, whose mean over the land is that colour,
 //! so the light the ground sends up to the clouds and the sky's tables
-//! keep the plain land's albedo. Each function has a WGSL twin of the same
-//! name in `shaders/land.wgsl`.
+//! keep the plain land's albedo; the flat ground's albedo where a ray
+//! meets it, and the terrain's. Each function has a WGSL twin of the same
+//! name in `shaders/land.wgsl` (`terrain_albedo`'s is in
+//! `shaders/terrain.wgsl`).
 //!
 //! The woods are a threshold of the detail volume's base channel
 //! ([`crate::render::noise_volume`]) read on a horizontal slice at two
@@ -20,6 +22,7 @@
 use glam::Vec3;
 
 use super::density::{NOISE_MAX_LOD, gained, lod_of};
+use super::renderer::Frame;
 use super::sky::LAND_ALBEDO;
 use crate::render::noise_volume::{NoiseVolume, SIZE as NOISE_SIZE};
 
@@ -182,6 +185,64 @@ pub fn land_albedo(x: f32, z: f32, footprint_m: f32, volume: &NoiseVolume) -> Ve
     let woods = woods_cover(x, z, footprint_m, volume);
     let tint = field_tint(x, z, footprint_m).lerp(WOODS, woods);
     LAND_ALBEDO * tint / LAND_TINT_MEAN
+}
+
+/// The terrain's albedo where it is flat (grass) and where its slope,
+/// `1 - n.y`, is a third or more (bare rock and soil), linear between
+/// (`TERRAIN_ALBEDO_FLAT` and `TERRAIN_ALBEDO_STEEP` in
+/// `shaders/terrain.wgsl`).
+pub const TERRAIN_ALBEDO_FLAT: Vec3 = Vec3::new(0.07, 0.11, 0.04);
+pub const TERRAIN_ALBEDO_STEEP: Vec3 = Vec3::new(0.16, 0.13, 0.09);
+
+/// The terrain's albedo at `p` of normal `n` (seen along `dir` from `t`
+/// away by a pixel of cone angle `spread`): level ground's
+/// [`TERRAIN_ALBEDO_FLAT`], times the land's tint over the plain land's
+/// when `land_fields` ([`land_albedo`] seen with the pixel's
+/// [`ground_footprint`]), toward [`TERRAIN_ALBEDO_STEEP`] as the slope
+/// `1 - n.y` grows to a third.
+pub fn terrain_albedo(p: Vec3, n: Vec3, dir: Vec3, t: f32, spread: f32, fr: &Frame) -> Vec3 {
+    let flat = if fr.quality.land_fields {
+        let footprint_m = ground_footprint(spread, t, dir.dot(n));
+        TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, fr.fields.cloud_map.noise())
+            / LAND_ALBEDO
+    } else {
+        TERRAIN_ALBEDO_FLAT
+    };
+    flat.lerp(TERRAIN_ALBEDO_STEEP, ((1.0 - n.y) * 3.0).min(1.0))
+}
+
+/// The width on the ground of a pixel of cone angle `spread` at distance
+/// `t`, its ray meeting the ground at cosine `cos_n` to the normal: the
+/// footprint's long axis, `spread · t / |cos_n|` (at most 20 times the
+/// short one, at grazing incidence).
+#[inline]
+pub fn ground_footprint(spread: f32, t: f32, cos_n: f32) -> f32 {
+    spread * t / cos_n.abs().max(0.05)
+}
+
+/// The flat ground's albedo where a ray of cone angle `spread` from
+/// `origin` along `dir` meets it (y = 0): the fields' [`land_albedo`]
+/// there when `land_fields`, faded to [`LAND_ALBEDO`] over the last
+/// quarter of `max_distance_m` (where the rays stop, so the land seen
+/// further has no seam); [`LAND_ALBEDO`] when off, when the ray looks
+/// up, or beyond `max_distance_m`.
+pub fn flat_ground_albedo(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Vec3 {
+    if !fr.quality.land_fields || dir.y >= 0.0 || origin.y <= 0.0 {
+        return LAND_ALBEDO;
+    }
+    let t = origin.y / -dir.y;
+    if t > fr.quality.max_distance_m {
+        return LAND_ALBEDO;
+    }
+    let (x, z) = (origin.x + dir.x * t, origin.z + dir.z * t);
+    let land = land_albedo(
+        x,
+        z,
+        ground_footprint(spread, t, dir.y),
+        fr.fields.cloud_map.noise(),
+    );
+    let far = (4.0 * t / fr.quality.max_distance_m - 3.0).clamp(0.0, 1.0);
+    land.lerp(LAND_ALBEDO, far)
 }
 
 #[inline]

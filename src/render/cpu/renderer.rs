@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
-use super::land::land_albedo;
+use super::land::{flat_ground_albedo, terrain_albedo};
 use super::light_volume::LightVolume;
 use super::lighting::{
     ShadowSteps, diffused_fluence, forward_step_factor, integrate_step, shadow_offset,
@@ -17,8 +17,8 @@ use super::lighting::{
 };
 use super::sea::sea_reflection_change;
 use super::sky::{
-    AtmosphereConfig, LAND_ALBEDO, SkyLight, aerial, background_radiance, ground_cloud_light,
-    ground_up, sky_ambient, sun_direction, sun_light_at,
+    AtmosphereConfig, SkyLight, aerial, background_radiance, ground_cloud_light, ground_up,
+    sky_ambient, sun_direction, sun_light_at,
 };
 use super::sky_luts::SkyLuts;
 pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
@@ -328,19 +328,13 @@ pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
     }
 }
 
-/// The terrain's albedo where it is flat (grass) and where its slope,
-/// `1 - n.y`, is a third or more (bare rock and soil), linear between
-/// (`TERRAIN_ALBEDO_FLAT` and `TERRAIN_ALBEDO_STEEP` in
-/// `shaders/terrain.wgsl`).
-pub const TERRAIN_ALBEDO_FLAT: Vec3 = Vec3::new(0.07, 0.11, 0.04);
-pub const TERRAIN_ALBEDO_STEEP: Vec3 = Vec3::new(0.16, 0.13, 0.09);
-
 /// Radiance of the terrain at `p` (distance `t` along `dir`, seen by a
 /// pixel of cone angle `spread`): lit by the sun through the clouds
 /// (their shadow, when shadows are on), the sky and the sunlight the
 /// clouds scatter down (`ground_cloud_light`), faded by aerial
 /// perspective. With `land_fields` its level ground's albedo carries the
-/// fields' and woods' tint ([`terrain_albedo`]).
+/// fields' and woods' tint
+/// ([`super::land::terrain_albedo`]).
 pub fn terrain_radiance(
     p: Vec3,
     t: f32,
@@ -364,57 +358,6 @@ pub fn terrain_radiance(
     let lit = albedo * (sun * (n.dot(sun_dir).max(0.0) * shadow / PI) + sky * (0.5 + 0.5 * n.y));
     let (inscatter, haze) = aerial(light, dir, t, sun_dir);
     lit * haze + inscatter
-}
-
-/// The terrain's albedo at `p` of normal `n` (seen along `dir` from `t`
-/// away by a pixel of cone angle `spread`): level ground's
-/// [`TERRAIN_ALBEDO_FLAT`], times the land's tint over the plain land's
-/// when `land_fields` ([`land_albedo`] seen with the pixel's
-/// [`ground_footprint`]), toward [`TERRAIN_ALBEDO_STEEP`] as the slope
-/// `1 - n.y` grows to a third.
-pub fn terrain_albedo(p: Vec3, n: Vec3, dir: Vec3, t: f32, spread: f32, fr: &Frame) -> Vec3 {
-    let flat = if fr.quality.land_fields {
-        let footprint_m = ground_footprint(spread, t, dir.dot(n));
-        TERRAIN_ALBEDO_FLAT * land_albedo(p.x, p.z, footprint_m, fr.fields.cloud_map.noise())
-            / LAND_ALBEDO
-    } else {
-        TERRAIN_ALBEDO_FLAT
-    };
-    flat.lerp(TERRAIN_ALBEDO_STEEP, ((1.0 - n.y) * 3.0).min(1.0))
-}
-
-/// The width on the ground of a pixel of cone angle `spread` at distance
-/// `t`, its ray meeting the ground at cosine `cos_n` to the normal: the
-/// footprint's long axis, `spread · t / |cos_n|` (at most 20 times the
-/// short one, at grazing incidence).
-#[inline]
-pub fn ground_footprint(spread: f32, t: f32, cos_n: f32) -> f32 {
-    spread * t / cos_n.abs().max(0.05)
-}
-
-/// The flat ground's albedo where a ray of cone angle `spread` from
-/// `origin` along `dir` meets it (y = 0): the fields' [`land_albedo`]
-/// there when `land_fields`, faded to [`LAND_ALBEDO`] over the last
-/// quarter of `max_distance_m` (where the rays stop, so the land seen
-/// further has no seam); [`LAND_ALBEDO`] when off, when the ray looks
-/// up, or beyond `max_distance_m`.
-pub fn flat_ground_albedo(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Vec3 {
-    if !fr.quality.land_fields || dir.y >= 0.0 || origin.y <= 0.0 {
-        return LAND_ALBEDO;
-    }
-    let t = origin.y / -dir.y;
-    if t > fr.quality.max_distance_m {
-        return LAND_ALBEDO;
-    }
-    let (x, z) = (origin.x + dir.x * t, origin.z + dir.z * t);
-    let land = land_albedo(
-        x,
-        z,
-        ground_footprint(spread, t, dir.y),
-        fr.fields.cloud_map.noise(),
-    );
-    let far = (4.0 * t / fr.quality.max_distance_m - 3.0).clamp(0.0, 1.0);
-    land.lerp(LAND_ALBEDO, far)
 }
 
 /// The clouds' shadow where a ray that meets no terrain reaches the flat

@@ -485,7 +485,7 @@ pub fn ground_up(sky: &SkyLight, sun_dir: Vec3, sea: bool) -> Vec3 {
 /// `sea_wind_mps`, the sea ([`sea_radiance`], mirroring the clouds of
 /// `reflection`), in the clouds' `shadow` where the ray meets them; the
 /// land of albedo `land` there ([`LAND_ALBEDO`], or the fields'
-/// [`super::renderer::flat_ground_albedo`]).
+/// [`super::land::flat_ground_albedo`]).
 #[inline]
 pub fn background_radiance(
     sky: &SkyLight,
