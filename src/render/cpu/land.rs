@@ -313,6 +313,16 @@ mod tests {
     }
 
     #[test]
+    fn the_tints_means_are_the_crops_and_the_woods() {
+        // CROPS_MEAN and LAND_TINT_MEAN are written out (their WGSL twins
+        // are literals); they must stay the means of what they stand for.
+        let crops = (0..4).map(crop).sum::<Vec3>() / 4.0;
+        assert!((crops - CROPS_MEAN).abs().max_element() < 1e-6, "{crops}");
+        let land = WOODS * WOODS_SHARE + CROPS_MEAN * (1.0 - WOODS_SHARE);
+        assert!((land - LAND_TINT_MEAN).abs().max_element() < 1e-6, "{land}");
+    }
+
+    #[test]
     fn fields_fade_to_their_mean_where_a_pixel_covers_them() {
         // Up to half a field's width each parcel keeps its crop; from a
         // whole width on, every point has the crops' mean; between, the
