@@ -113,6 +113,40 @@ fn negative_radius_names_key() {
     );
 }
 
+/// A value past a key's upper bound gets an error that states the whole
+/// range: these messages once said "expected > 0" of 1e6 (exposure) and
+/// 2e5 m (a parcel's radius), both above zero.
+#[test]
+fn out_of_range_errors_state_the_range() {
+    assert_simulate_fails(
+        "[physics]\nradius_m = 200000\n",
+        None,
+        &["bad.toml:2", "physics.radius_m", "200000", "1e-3..=1e5 m"],
+    );
+    assert_simulate_fails(
+        "[physics.recycling]\nmax_age_s = 1e10\n",
+        None,
+        &["bad.toml:2", "physics.recycling.max_age_s", "1e-3..=1e9 s"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    for (key, value, range) in [
+        ("exposure", "1e6", "0.001..=1000"),
+        ("extinction_per_m", "1e-7", "1e-6..=10 1/m"),
+        ("max_distance_m", "1e8", "1..=1e7 m"),
+        ("haze_distance_m", "0.5", "1..=1e7 m"),
+    ] {
+        let p = dir.path().join("s.toml");
+        std::fs::write(&p, format!("[render]\n{key} = {value}\n")).unwrap();
+        let o = cumulus(&["scene", "check", p.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(1), "{key}");
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("s.toml:2: `render.{key}`")) && e.contains(range),
+            "{key}: {e}"
+        );
+    }
+}
+
 #[test]
 fn nan_field_is_rejected() {
     assert_simulate_fails(

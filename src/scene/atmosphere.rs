@@ -37,7 +37,7 @@ impl AtmosphereSection {
                 self.inversion_base_m,
                 0.0,
                 1e5,
-                ">= 0 m",
+                "0..=1e5 m",
             ),
         ]
         .into_iter()

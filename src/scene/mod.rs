@@ -310,7 +310,7 @@ mod tests {
         .expect_err("negative");
         assert_eq!(
             e.to_string(),
-            "s.toml:3: `physics.radius_m`: is -5, expected a radius > 0 m"
+            "s.toml:3: `physics.radius_m`: is -5, expected 1e-3..=1e5 m"
         );
     }
 

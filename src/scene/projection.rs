@@ -52,11 +52,11 @@ impl ProjectionSection {
     /// The band's bottom and top, when given, against their domains.
     pub fn band_checks(&self) -> Vec<Check> {
         let mut checks: Vec<Check> = [
-            ("projection.band_bottom_m", self.band_bottom_m, ">= 0 m"),
+            ("projection.band_bottom_m", self.band_bottom_m, "0..=1e5 m"),
             (
                 "projection.band_top_m",
                 self.band_top_m,
-                ">= 0 m and above band_bottom_m",
+                "0..=1e5 m and above band_bottom_m",
             ),
         ]
         .into_iter()

@@ -230,7 +230,7 @@ impl RenderSettings {
                 f(r.extinction_per_m),
                 1e-6,
                 10.0,
-                "> 0 1/m",
+                "1e-6..=10 1/m",
             ),
             Check::new(
                 "render.steps",
@@ -250,16 +250,16 @@ impl RenderSettings {
                 f(r.haze_distance_m),
                 1.0,
                 1e7,
-                "> 0 m",
+                "1..=1e7 m",
             ),
             range(
                 "render.max_distance_m",
                 f(r.max_distance_m),
                 1.0,
                 1e7,
-                "> 0 m",
+                "1..=1e7 m",
             ),
-            range("render.exposure", f(r.exposure), 1e-3, 1e3, "> 0"),
+            range("render.exposure", f(r.exposure), 1e-3, 1e3, "0.001..=1000"),
             range("render.time_s", r.time_s, 0.0, 1e7, "0..=1e7 s"),
             range("render.tsaa_blend", f(r.tsaa_blend), 1e-3, 1.0, "0.001..=1"),
             Check::new(
@@ -300,7 +300,7 @@ impl RenderSettings {
                 f(r.terrain.extent_m),
                 1.0,
                 1e7,
-                "> 0 m",
+                "1..=1e7 m",
             ),
             range("render.terrain.hills", r.terrain.hills, 1.0, 64.0, "1..=64"),
             range(

@@ -27,21 +27,27 @@ impl PhysicsConfig {
                 1e7,
                 "1..=1e7 m",
             ),
-            r("physics.radius_m", p.radius_m, 1e-3, 1e5, "a radius > 0 m"),
-            r("physics.radius_jitter", p.radius_jitter, 0.0, 0.99, "0..<1"),
+            r("physics.radius_m", p.radius_m, 1e-3, 1e5, "1e-3..=1e5 m"),
+            r(
+                "physics.radius_jitter",
+                p.radius_jitter,
+                0.0,
+                0.99,
+                "0..=0.99",
+            ),
             r(
                 "physics.release_height_m",
                 p.release_height_m,
                 0.0,
                 1e5,
-                ">= 0 m",
+                "0..=1e5 m",
             ),
             r(
                 "physics.release_stagger_s",
                 p.release_stagger_s,
                 0.0,
                 1e7,
-                ">= 0 s",
+                "0..=1e7 s",
             ),
             r(
                 "physics.initial_excess_k",
@@ -105,14 +111,14 @@ impl PhysicsConfig {
                 p.recycling.max_age_s,
                 1e-3,
                 1e9,
-                "> 0 s",
+                "1e-3..=1e9 s",
             ),
             Check::new(
                 "physics.sph.smoothing_radii",
                 super::check::finite_in(p.sph.smoothing_radii, 1e-3, 100.0)
                     && (!p.sph.enabled
                         || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m),
-                "> 0, with smoothing_radii * radius_m <= domain_size_m / 2",
+                "1e-3..=100, with smoothing_radii * radius_m <= domain_size_m / 2",
                 p.sph.smoothing_radii,
             ),
             r(
@@ -120,14 +126,14 @@ impl PhysicsConfig {
                 p.sph.sound_speed_mps,
                 1e-6,
                 1e3,
-                "> 0 m/s",
+                "1e-6..=1000 m/s",
             ),
             r(
                 "physics.sph.viscosity_m2ps",
                 p.sph.viscosity_m2ps,
                 0.0,
                 1e7,
-                ">= 0 m²/s",
+                "0..=1e7 m²/s",
             ),
             r(
                 "physics.wind.speed_mps",
@@ -161,7 +167,7 @@ impl PhysicsConfig {
                 p.substeps.max_rise_m,
                 1e-3,
                 1e5,
-                "> 0 m",
+                "1e-3..=1e5 m",
             ),
             r(
                 "physics.substeps.sph_courant",

@@ -111,7 +111,7 @@ impl ParametricProfile {
                 pp.humidity_scale_height_m,
                 1.0,
                 1e6,
-                ">= 1 m",
+                "1..=1e6 m",
             ),
             (
                 "humidity_drop_above_inversion",
