@@ -26,7 +26,17 @@ const CROP_SOIL: vec3f = vec3f(1.35, 0.95, 0.85);
 const CROP_STUBBLE: vec3f = vec3f(1.65, 1.35, 1.3);
 const WOODS: vec3f = vec3f(0.45, 0.55, 0.45);
 const CROPS_MEAN: vec3f = vec3f(1.3125, 1.1625, 0.9625);
-const LAND_TINT_MEAN: vec3f = vec3f(1.05375, 0.97875, 0.80875);
+const HEDGE_M: f32 = 4.0;
+const HEDGE_CHANCE: f32 = 0.7;
+const HEDGE: vec3f = vec3f(0.4, 0.5, 0.36);
+const FIELDS_MEAN: vec3f = vec3f(1.2802312, 1.139072, 0.9411938);
+const LAND_TINT_MEAN: vec3f = vec3f(1.0311618, 0.9623504, 0.7938356);
+const PATCH_TILE_M: f32 = 530.0;
+const PATCH_CONTRAST: f32 = 0.12;
+const CROWN_M: f32 = 9.0;
+const SMALL_CROWN_M: f32 = 5.5;
+const CANOPY_FLOOR: f32 = 0.7;
+const CROWN_LIGHT_MEAN: f32 = 0.534;
 
 // A hash of a field's cell (the CPU's `field_hash`).
 fn field_hash(i: i32, j: i32) -> u32 {
@@ -67,7 +77,7 @@ fn farm(x: f32, z: f32) -> u32 {
 fn field_tint(x: f32, z: f32, footprint_m: f32) -> vec3f {
     let fade = clamp(2.0 - 2.0 * footprint_m / FIELD_WIDTH_M, 0.0, 1.0);
     if fade <= 0.0 {
-        return CROPS_MEAN;
+        return FIELDS_MEAN;
     }
     let b = farm(x, z);
     let angle = FIELD_ANGLE + FARM_TURN * f32(b & 3u);
@@ -78,10 +88,77 @@ fn field_tint(x: f32, z: f32, footprint_m: f32) -> vec3f {
     let row = i32(floor(across / FIELD_WIDTH_M));
     let r = field_hash(row, i32(b >> 8u));
     let length = FIELD_LENGTH_M * (0.6 + 0.8 * f32((r >> 12u) & 255u) / 255.0);
-    let field = i32(floor(along / length + f32(r & 1023u) / 1024.0));
+    let u = along / length + f32(r & 1023u) / 1024.0;
+    let field = i32(floor(u));
     let h = field_hash(row, field) ^ b;
     let shade = 1.0 + 0.24 * (f32((h >> 8u) & 255u) / 255.0 - 0.5);
-    return mix(CROPS_MEAN, crop(h) * shade, fade);
+    let patches = 1.0 + 2.0 * PATCH_CONTRAST * (woods_noise(x, z, footprint_m, PATCH_TILE_M, 0.375) - 0.5);
+    let next_row = field_hash(row + 1, i32(b >> 8u));
+    let between_rows = hedge_cover(across - f32(row) * FIELD_WIDTH_M, FIELD_WIDTH_M, footprint_m,
+        hedged(r), hedged(next_row));
+    let between_fields = hedge_cover((u - f32(field)) * length, length, footprint_m, hedged(h),
+        hedged(field_hash(row, field + 1) ^ b));
+    let hedge = 1.0 - (1.0 - between_rows) * (1.0 - between_fields);
+    let tint = mix(crop(h) * (shade * patches), HEDGE, hedge);
+    return mix(FIELDS_MEAN, tint, fade);
+}
+
+// 1 where the boundary of hash h is hedged (the CPU's `hedged`).
+fn hedged(h: u32) -> f32 {
+    if f32(h >> 22u) < HEDGE_CHANCE * 1024.0 {
+        return 1.0;
+    }
+    return 0.0;
+}
+
+// The hedges' cover of a footprint a metres into a parcel (the CPU's
+// `hedge_cover`).
+fn hedge_cover(a: f32, period: f32, footprint_m: f32, start: f32, end: f32) -> f32 {
+    let half = 0.5 * max(footprint_m, 1e-3);
+    let lo = a - half;
+    let hi = a + half;
+    let first = max(min(hi, HEDGE_M) - max(lo, 0.0), 0.0);
+    let second = max(min(hi, period + HEDGE_M) - max(lo, period), 0.0);
+    return min((start * first + end * second) / (2.0 * half), 1.0);
+}
+
+// The light of the tree crowns at (x, z) (the CPU's `crown_light`).
+fn crown_light(x: f32, z: f32) -> f32 {
+    return max(crown_layer(x / CROWN_M, z / CROWN_M, 0),
+        0.8 * crown_layer(x / SMALL_CROWN_M + 0.37, z / SMALL_CROWN_M + 0.61, 7919));
+}
+
+// One layer of tree crowns (the CPU's `crown_layer`).
+fn crown_layer(u: f32, w: f32, salt: i32) -> f32 {
+    let ci = i32(floor(u));
+    let ck = i32(floor(w));
+    var nearest = 3.4028235e38;
+    var light = 0.0;
+    for (var dk = -1; dk <= 1; dk++) {
+        for (var di = -1; di <= 1; di++) {
+            let h = field_hash(ci + di + salt, ck + dk) * 0x9e3779b9u;
+            let px = f32(ci + di) + (f32(h & 255u) + 0.5) / 256.0;
+            let pz = f32(ck + dk) + (f32((h >> 8u) & 255u) + 0.5) / 256.0;
+            let d2 = (u - px) * (u - px) + (w - pz) * (w - pz);
+            if d2 < nearest {
+                nearest = d2;
+                let radius = 0.55 + 0.25 * f32((h >> 24u) & 255u) / 255.0;
+                let shade = 0.6 + 0.4 * f32((h >> 16u) & 255u) / 255.0;
+                light = max(1.0 - d2 / (radius * radius), 0.0) * shade;
+            }
+        }
+    }
+    return light;
+}
+
+// The woods' canopy at (x, z) (the CPU's `canopy`).
+fn canopy(x: f32, z: f32, footprint_m: f32) -> f32 {
+    let fade = clamp(2.0 - 2.0 * footprint_m / CROWN_M, 0.0, 1.0);
+    if fade <= 0.0 {
+        return 1.0;
+    }
+    let crowns = (CANOPY_FLOOR + crown_light(x, z)) / (CANOPY_FLOOR + CROWN_LIGHT_MEAN);
+    return 1.0 + (crowns - 1.0) * fade;
 }
 
 // One scale of the woods' noise (the CPU's `woods_noise`).
@@ -105,7 +182,12 @@ fn woods_cover(x: f32, z: f32, footprint_m: f32) -> f32 {
 
 // The land's albedo at (x, z) (the CPU's `land_albedo`).
 fn land_albedo(x: f32, z: f32, footprint_m: f32) -> vec3f {
-    let tint = mix(field_tint(x, z, footprint_m), WOODS, woods_cover(x, z, footprint_m));
+    let woods = woods_cover(x, z, footprint_m);
+    var trees = WOODS;
+    if woods > 0.0 {
+        trees = WOODS * canopy(x, z, footprint_m);
+    }
+    let tint = mix(field_tint(x, z, footprint_m), trees, woods);
     return LAND_ALBEDO * tint / LAND_TINT_MEAN;
 }
 

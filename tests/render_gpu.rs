@@ -7,6 +7,7 @@ mod common;
 
 use common::gpu;
 use cumulus::prepare::Prepared;
+use cumulus::render::cpu::land;
 use cumulus::render::cpu::lighting::{SHADOW_RAY_M, forward_step_factor, shadow_step_count};
 use cumulus::render::cpu::renderer::{render_converged, render_linear, to_srgb8};
 use cumulus::render::cpu::sky::SkyModel;
@@ -167,6 +168,55 @@ fn gpu_matches_cpu_reference_on_the_fields() {
             PARITY_OUTLIERS,
         );
     }
+    // Low over the land.
+    sc.render.camera_position_m = [5230.0, 40.0, 4870.0];
+    sc.render.camera_pitch_deg = -30.0;
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
+    // Straight down from 25 m onto a hedge in the open (found with the CPU
+    // twins), a tenth of the picture, and onto the woods' crowns.
+    let prepared = Prepared::from_scene(&sc, || {}).expect("prepare");
+    let fr = prepared.frame(&sc.render, sc.render.quality());
+    let volume = fr.fields.cloud_map.noise();
+    let hedge = (0..4000)
+        .map(|k| 5000.0 + 0.5 * k as f32)
+        .find(|&x| {
+            (land::field_tint(x, 5000.0, 0.0, volume) - land::HEDGE)
+                .abs()
+                .max_element()
+                < 1e-3
+                && land::woods_cover(x, 5000.0, 0.0, volume) == 0.0
+        })
+        .expect("a hedge within 2 km");
+    let wood = (0..400)
+        .map(|k| 5000.0 + 25.0 * k as f32)
+        .find(|&x| land::woods_cover(x, 5000.0, 0.0, volume) == 1.0)
+        .expect("a wood within 10 km");
+    sc.render.camera_pitch_deg = -89.0;
+    sc.render.camera_position_m = [wood, 25.0, 5000.0];
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
+    sc.render.camera_position_m = [hedge, 25.0, 5000.0];
+    parity(
+        &ctx,
+        &sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
 }
 
 #[test]

@@ -79,6 +79,14 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("WOODS_SOFTEST", land::WOODS_SOFTEST as f64),
         ("WOODS_FADE_M", land::WOODS_FADE_M as f64),
         ("WOODS_SHARE", land::WOODS_SHARE as f64),
+        ("HEDGE_M", land::HEDGE_M as f64),
+        ("HEDGE_CHANCE", land::HEDGE_CHANCE as f64),
+        ("PATCH_TILE_M", land::PATCH_TILE_M as f64),
+        ("PATCH_CONTRAST", land::PATCH_CONTRAST as f64),
+        ("CROWN_M", land::CROWN_M as f64),
+        ("SMALL_CROWN_M", land::SMALL_CROWN_M as f64),
+        ("CANOPY_FLOOR", land::CANOPY_FLOOR as f64),
+        ("CROWN_LIGHT_MEAN", land::CROWN_LIGHT_MEAN as f64),
         ("BASE_RAMP", density::BASE_RAMP as f64),
         ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
@@ -314,6 +322,8 @@ fn rust_vectors() -> Vec<(&'static str, glam::Vec3)> {
         ("CROP_STUBBLE", land::CROP_STUBBLE),
         ("CROPS_MEAN", land::CROPS_MEAN),
         ("LAND_TINT_MEAN", land::LAND_TINT_MEAN),
+        ("HEDGE", land::HEDGE),
+        ("FIELDS_MEAN", land::FIELDS_MEAN),
     ]
 }
 
