@@ -14,6 +14,9 @@
 override SHADOW_STEPS: u32 = 20u;
 override OCTAVES: u32 = 3u;
 override DETAIL: bool = true;
+// The fine billows near the camera (`[render] fine_detail`), read only
+// with DETAIL.
+override FINE_DETAIL: bool = true;
 override DEBUG_COUNT: bool = false;
 // The sea below the horizon (else land), and its wind speed (m/s).
 override SEA: bool = false;
@@ -37,6 +40,9 @@ const NEAR_M: f32 = 3000.0;
 const DETAIL_TILE: f32 = 4.0;
 const BILLOW_FREQUENCY: f32 = 1.618;
 const BASE_WEIGHT: f32 = 0.85;
+const FINE_FREQUENCY: f32 = 4.0;
+const FINE_WEIGHT: f32 = 0.16;
+const FINE_SHARP_M: f32 = 3.0;
 const NOISE_SIZE: f32 = 64.0;
 const NOISE_MAX_LOD: f32 = 5.0;
 const BLUE_NOISE_SIZE: u32 = 64u;
@@ -182,6 +188,27 @@ fn detail_billows(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
     return gained(textureSampleLevel(noise_tex, wrap_linear, q, lod).g, lod);
 }
 
+// The fine billows' weight at a footprint (the CPU's `fine_weight`).
+fn fine_weight(footprint_m: f32) -> f32 {
+    if !FINE_DETAIL {
+        return 0.0;
+    }
+    return FINE_WEIGHT * clamp(2.0 - footprint_m / FINE_SHARP_M, 0.0, 1.0);
+}
+
+// The fine billows near the camera, about 0 (the CPU's `detail_fine`).
+fn detail_fine(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
+    let w = fine_weight(footprint_m);
+    if w <= 0.0 {
+        return 0.0;
+    }
+    let tile_m = DETAIL_TILE * scale_m;
+    let texel_m = tile_m / NOISE_SIZE;
+    let lod = min(lod_of(footprint_m * FINE_FREQUENCY, texel_m), NOISE_MAX_LOD);
+    let q = p * (FINE_FREQUENCY / tile_m) + vec3f(0.57, 0.11, 0.29);
+    return w * (gained(textureSampleLevel(noise_tex, wrap_linear, q, lod).g, lod) - 0.5);
+}
+
 // True where the coarse max-coverage mask says no P texel near map
 // coordinate `(u, v)` has coverage: the density there is zero, so the
 // texture reads are skipped.
@@ -296,21 +323,31 @@ fn surface_profile(m: f32, n: f32, s: f32, threshold: f32) -> f32 {
 }
 
 // surface_profile of the detail noise (the CPU's `detail_noise`: base and
-// billows weighted by BASE_WEIGHT), reading the volume only where it can
-// change the result (the CPU's `detail_profile`).
+// billows weighted by BASE_WEIGHT, and the fine billows near the camera),
+// reading the volume only where it can change the result (the CPU's
+// `detail_profile`).
 fn detail_profile(p: vec3f, m: f32, threshold: f32, s: f32, scale_m: f32, footprint_m: f32) -> f32 {
-    if surface_profile(m, 0.0, s, threshold) >= 1.0 {
+    let fine = 0.5 * fine_weight(footprint_m);
+    if surface_profile(m, -fine, s, threshold) >= 1.0 {
         return 1.0;
     }
     let low = BASE_WEIGHT * detail_base(p, scale_m, footprint_m);
-    if surface_profile(m, low + (1.0 - BASE_WEIGHT), s, threshold) <= 0.0 {
+    if surface_profile(m, low + (1.0 - BASE_WEIGHT) + fine, s, threshold) <= 0.0 {
         return 0.0;
     }
-    if surface_profile(m, low, s, threshold) >= 1.0 {
+    if surface_profile(m, low - fine, s, threshold) >= 1.0 {
         return 1.0;
     }
     let n = low + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m);
-    return surface_profile(m, n, s, threshold);
+    if fine > 0.0 {
+        if surface_profile(m, n + fine, s, threshold) <= 0.0 {
+            return 0.0;
+        }
+        if surface_profile(m, n - fine, s, threshold) >= 1.0 {
+            return 1.0;
+        }
+    }
+    return surface_profile(m, n + detail_fine(p, scale_m, footprint_m), s, threshold);
 }
 
 // Where p reads the detail volume: warped outside the simulated domain

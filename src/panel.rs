@@ -40,6 +40,8 @@ pub struct PanelState {
     pub terrain: bool,
     /// The land as fields and woods (off: plain; `[render.ground] land`).
     pub fields: bool,
+    /// The fine billows near the camera (`[render] fine_detail`).
+    pub fine_detail: bool,
     /// The physical sky (off: the analytic one).
     pub physical_sky: bool,
     /// The physical sky's aerosol optical depth, 0..=3.
@@ -65,6 +67,7 @@ impl PanelState {
             octaves: r.octaves,
             terrain: r.terrain.enabled,
             fields: r.ground.land == Land::Fields,
+            fine_detail: r.fine_detail,
             physical_sky: r.atmosphere.model == SkyModel::Physical,
             aerosol_optical_depth: r.atmosphere.aerosol_optical_depth,
         }
@@ -81,6 +84,7 @@ impl PanelState {
         r.shadow_steps = self.shadow_steps;
         r.octaves = self.octaves;
         r.terrain.enabled = self.terrain;
+        r.fine_detail = self.fine_detail;
         r.ground.land = if self.fields {
             Land::Fields
         } else {

@@ -24,6 +24,7 @@ fn roundtrip(name: &str) {
     panel.octaves = 1;
     panel.terrain = !panel.terrain;
     panel.fields = !panel.fields;
+    panel.fine_detail = !panel.fine_detail;
     panel.physical_sky = !panel.physical_sky;
     panel.aerosol_optical_depth = 0.42;
     panel.apply(&mut scene);

@@ -31,6 +31,7 @@ const D: DensityParams = DensityParams {
     map_extent_m: 10_000.0,
     detail_strength: 0.0,
     detail_scale_m: 250.0,
+    fine_detail: true,
 };
 
 /// `steps` shadow steps, no more toward the sun, each sample at its

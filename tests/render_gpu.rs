@@ -223,7 +223,20 @@ fn gpu_matches_cpu_reference_on_the_fields() {
 fn gpu_matches_cpu_reference_above_and_inside_the_band() {
     let Some(ctx) = gpu() else { return };
     // strong_inversion looks down on the layer from above.
-    let above = scene("strong_inversion");
+    let mut above = scene("strong_inversion");
+    parity(
+        &ctx,
+        &above,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
+    // The same without the fine billows near the camera (compiled out on
+    // the GPU; this view's nearest tops have them: with the WGSL's left
+    // in here, or taken out above, the mean doubles and 60 channels are
+    // off by more than 0.05).
+    above.render.fine_detail = false;
     parity(
         &ctx,
         &above,

@@ -157,6 +157,9 @@ pub fn panel(
         ch |= ui
             .checkbox(&mut p.fields, "fields and woods (off: plain land)")
             .changed();
+        ch |= ui
+            .checkbox(&mut p.fine_detail, "fine billows near the camera")
+            .changed();
         a.panel_changed = ch;
         ui.separator();
         ui.label("Camera (drag: look/orbit, WASD/QE: fly, Shift: fast, wheel: speed/zoom)");

@@ -114,6 +114,7 @@ mod tests {
             map_extent_m: 10_000.0,
             detail_strength: 0.8,
             detail_scale_m: 400.0,
+            fine_detail: true,
         };
         let mask = CoverageMask::build(&p);
         let f = Fields {

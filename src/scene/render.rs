@@ -60,6 +60,11 @@ pub struct RenderSettings {
     pub detail_strength: f32,
     /// Size of the detail noise's largest features, m (> 0). Default 180.
     pub detail_scale_m: f32,
+    /// The fine billows near the camera (`render::cpu::density::detail_fine`:
+    /// the detail volume again at 4 times the base's frequency, where a
+    /// pixel covers under 6 m). Default true; the path-traced comparisons
+    /// turn it off, since the exported grid (9.7 m cells) cannot hold it.
+    pub fine_detail: bool,
     /// Primary march steps (1..=4096). Default 48 (chosen from
     /// `cumulus render --quality-report`, see README).
     pub steps: u32,
@@ -128,6 +133,7 @@ impl Default for RenderSettings {
             extinction_per_m: 0.04,
             detail_strength: 0.6,
             detail_scale_m: 180.0,
+            fine_detail: true,
             steps: 48,
             shadow_steps: 20,
             octaves: 3,
@@ -374,6 +380,7 @@ impl RenderSettings {
             map_extent_m: map_extent_m as f32,
             detail_strength: self.detail_strength,
             detail_scale_m: self.detail_scale_m,
+            fine_detail: self.fine_detail,
         }
     }
 

@@ -25,6 +25,9 @@ pub struct DensityParams {
     pub detail_strength: f32,
     /// Size of the detail noise's features, m.
     pub detail_scale_m: f32,
+    /// The fine billows near the camera ([`detail_fine`]; not evaluated
+    /// when off).
+    pub fine_detail: bool,
 }
 
 /// The textures the density reads.
@@ -163,9 +166,66 @@ pub fn detail_billows(p: Vec3, scale_m: f32, footprint_m: f32, volume: &NoiseVol
 /// `footprint_m` (far away, where a pixel covers many texels, the mips
 /// average the billows out instead of aliasing them).
 #[inline]
-pub fn detail_noise(p: Vec3, scale_m: f32, footprint_m: f32, volume: &NoiseVolume) -> f32 {
+pub fn detail_noise(
+    p: Vec3,
+    scale_m: f32,
+    footprint_m: f32,
+    fine: bool,
+    volume: &NoiseVolume,
+) -> f32 {
     let base = detail_base(p, scale_m, footprint_m, volume);
-    BASE_WEIGHT * base + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m, volume)
+    BASE_WEIGHT * base
+        + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m, volume)
+        + detail_fine(p, scale_m, footprint_m, fine, volume)
+}
+
+/// The fine billows' frequency over the base channel's (the billows
+/// channel read over tiles of 180 m at the default 180 m scale, texels
+/// of 2.8 m): the small turrets of a cloud seen from a few hundred
+/// metres. At 6.7 they were finer than the march's steps near the
+/// camera (25 m from under the base) and showed as grain.
+pub const FINE_FREQUENCY: f32 = 4.0;
+/// The fine billows' weight in the detail noise, near the camera.
+pub const FINE_WEIGHT: f32 = 0.16;
+/// The footprint (m) up to which the fine billows have all their
+/// weight; none from twice it (6 m: clouds within about 1.5-2.5 km at
+/// 640x480), so the far clouds, the field statistics and the volume
+/// export's grid (read at a footprint of its cell, 9.8 m at 1024 cells
+/// over 10 km) are as they were without them.
+pub const FINE_SHARP_M: f32 = 3.0;
+
+/// The weight of the fine billows at a footprint of `footprint_m`:
+/// [`FINE_WEIGHT`] up to [`FINE_SHARP_M`], falling to 0 at twice it; 0
+/// when they are off (`fine`; in WGSL the override `FINE_DETAIL`).
+#[inline]
+pub fn fine_weight(footprint_m: f32, fine: bool) -> f32 {
+    if !fine {
+        return 0.0;
+    }
+    FINE_WEIGHT * (2.0 - footprint_m / FINE_SHARP_M).clamp(0.0, 1.0)
+}
+
+/// The fine billows at `p`, about 0: the billows channel at
+/// [`FINE_FREQUENCY`] times the base's frequency, less its mean, times
+/// [`fine_weight`]. Near the camera they break a cloud's smooth surface
+/// into the small turrets and wisps the coarser channels cannot hold.
+#[inline]
+pub fn detail_fine(
+    p: Vec3,
+    scale_m: f32,
+    footprint_m: f32,
+    fine: bool,
+    volume: &NoiseVolume,
+) -> f32 {
+    let w = fine_weight(footprint_m, fine);
+    if w <= 0.0 {
+        return 0.0;
+    }
+    let tile_m = DETAIL_TILE * scale_m;
+    let texel_m = tile_m / NOISE_SIZE as f32;
+    let lod = lod_of(footprint_m * FINE_FREQUENCY, texel_m).min(NOISE_MAX_LOD);
+    let q = p * (FINE_FREQUENCY / tile_m) + Vec3::new(0.57, 0.11, 0.29);
+    w * (gained(volume.sample_level(q, lod)[1], lod) - 0.5)
 }
 
 /// The density profile, `0..1`, where the cloud field of map value `m`
@@ -181,29 +241,45 @@ pub fn surface_profile(m: f32, n: f32, s: f32, threshold: f32) -> f32 {
 /// noise, so where even the lowest noise saturates the profile, or the
 /// base channel's bounds on the noise decide it, the reads that remain are
 /// skipped (inside a cloud, most samples). Exactly `surface_profile(m,
-/// detail_noise(..), s, threshold)`.
+/// detail_noise(..), s, threshold)` at `d`'s `detail_scale_m`, with its
+/// fine billows when `d.fine_detail`.
 #[inline]
 pub fn detail_profile(
     p: Vec3,
     m: f32,
     threshold: f32,
     s: f32,
-    scale_m: f32,
     footprint_m: f32,
+    d: &DensityParams,
     volume: &NoiseVolume,
 ) -> f32 {
-    if surface_profile(m, 0.0, s, threshold) >= 1.0 {
+    let (scale_m, fine_detail) = (d.detail_scale_m, d.fine_detail);
+    let fine = 0.5 * fine_weight(footprint_m, fine_detail);
+    if surface_profile(m, -fine, s, threshold) >= 1.0 {
         return 1.0;
     }
     let low = BASE_WEIGHT * detail_base(p, scale_m, footprint_m, volume);
-    if surface_profile(m, low + (1.0 - BASE_WEIGHT), s, threshold) <= 0.0 {
+    if surface_profile(m, low + (1.0 - BASE_WEIGHT) + fine, s, threshold) <= 0.0 {
         return 0.0;
     }
-    if surface_profile(m, low, s, threshold) >= 1.0 {
+    if surface_profile(m, low - fine, s, threshold) >= 1.0 {
         return 1.0;
     }
     let n = low + (1.0 - BASE_WEIGHT) * detail_billows(p, scale_m, footprint_m, volume);
-    surface_profile(m, n, s, threshold)
+    if fine > 0.0 {
+        if surface_profile(m, n + fine, s, threshold) <= 0.0 {
+            return 0.0;
+        }
+        if surface_profile(m, n - fine, s, threshold) >= 1.0 {
+            return 1.0;
+        }
+    }
+    surface_profile(
+        m,
+        n + detail_fine(p, scale_m, footprint_m, fine_detail, volume),
+        s,
+        threshold,
+    )
 }
 
 /// Normalised height below which the base ramps up: the base is flat
@@ -447,7 +523,7 @@ pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool, footprin
     let profile = if detail && s > 0.0 {
         let volume = f.cloud_map.noise();
         let q = noise_point(p, lookup, d.map_extent_m);
-        detail_profile(q, m, threshold, s, d.detail_scale_m, footprint_m, volume)
+        detail_profile(q, m, threshold, s, footprint_m, d, volume)
     } else {
         surface_profile(m, 0.5, s, threshold)
     };
@@ -472,13 +548,50 @@ mod tests {
             let m = (t * 0.618_034).fract();
             let threshold = 0.3 + 0.7 * (t * 0.414_213).fract();
             let s = [0.3, 0.6, 1.0][k % 3];
-            let footprint = [0.0, 30.0, 400.0][(k / 3) % 3];
-            let full = surface_profile(m, detail_noise(p, 180.0, footprint, v), s, threshold);
-            let fast = detail_profile(p, m, threshold, s, 180.0, footprint, v);
+            let footprint = [0.0, 4.5, 30.0, 400.0][(k / 3) % 4];
+            let fine = k % 7 != 0;
+            let full = surface_profile(m, detail_noise(p, 180.0, footprint, fine, v), s, threshold);
+            let d = DensityParams {
+                band_bottom_m: 600.0,
+                band_top_m: 1600.0,
+                coverage: 0.75,
+                extinction_per_m: 0.04,
+                map_extent_m: 10_000.0,
+                detail_strength: s,
+                detail_scale_m: 180.0,
+                fine_detail: fine,
+            };
+            let fast = detail_profile(p, m, threshold, s, footprint, &d, v);
             assert_eq!(full.to_bits(), fast.to_bits(), "at {p}: {full} vs {fast}");
             decided += usize::from(fast == 0.0 || fast == 1.0);
         }
         assert!(decided > 1000 && decided < 19_000, "{decided} decided");
+    }
+
+    /// The fine billows are about 0 on the mean, break the surface near
+    /// the camera, and are gone from twice [`FINE_SHARP_M`] on.
+    #[test]
+    fn fine_billows_are_near_only() {
+        let map = CloudMap::generate(&CloudMapConfig::default());
+        let v = map.noise();
+        let at = |footprint: f32| -> Vec<f32> {
+            (0..20_000)
+                .map(|k| {
+                    let k = k as f32;
+                    let p = Vec3::new(k * 3.1, 800.0 + (k * 0.37).sin() * 300.0, k * 1.7);
+                    detail_fine(p, 180.0, footprint, true, v)
+                })
+                .collect()
+        };
+        let near = at(1.0);
+        let mean = near.iter().sum::<f32>() / near.len() as f32;
+        let sd = (near.iter().map(|f| (f - mean).powi(2)).sum::<f32>() / near.len() as f32).sqrt();
+        assert!(mean.abs() < 0.01, "mean {mean}");
+        assert!(sd > 0.2 * FINE_WEIGHT, "sd {sd}");
+        assert!(at(2.0 * FINE_SHARP_M).iter().all(|&f| f == 0.0));
+        assert!(at(9.8).iter().all(|&f| f == 0.0));
+        // Off, nothing near either.
+        assert_eq!(fine_weight(0.0, false), 0.0);
     }
 
     /// [`DETAIL_CONTRAST`] widens the detail noise to about a uniform
@@ -494,7 +607,7 @@ mod tests {
                 .map(|k| {
                     let k = k as f32;
                     let p = Vec3::new(k * 37.1, (k * 0.61).sin() * 900.0 + 1200.0, k * 13.7);
-                    detail_noise(p, 180.0, footprint, map.noise())
+                    detail_noise(p, 180.0, footprint, true, map.noise())
                 })
                 .collect();
             let mean = vals.iter().sum::<f32>() / n as f32;

@@ -39,6 +39,12 @@ impl GpuSettings {
         self.detail() || self.quality.land_fields
     }
 
+    /// Whether the fine billows near the camera are compiled in: with the
+    /// detail noise and `[render] fine_detail`.
+    pub fn fine_detail(&self) -> bool {
+        self.detail() && self.density.fine_detail
+    }
+
     /// Whether the light volume exists: with multiple scattering on
     /// (`octaves > 0`), as on the CPU ([`crate::prepare::Prepared::frame`]).
     pub fn light_volume(&self) -> bool {
@@ -64,6 +70,7 @@ impl GpuSettings {
             ("SHADOW_STEPS", self.quality.shadow_steps as f64),
             ("OCTAVES", self.quality.octaves as f64),
             ("DETAIL", flag(self.detail())),
+            ("FINE_DETAIL", flag(self.fine_detail())),
             ("DEBUG_COUNT", flag(self.debug_sample_count)),
             ("SEA", flag(self.quality.sea_wind_mps.is_some())),
             ("LAND_FIELDS", flag(self.quality.land_fields)),
