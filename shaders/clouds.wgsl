@@ -43,6 +43,7 @@ const BASE_WEIGHT: f32 = 0.85;
 const FINE_FREQUENCY: f32 = 4.0;
 const FINE_WEIGHT: f32 = 0.16;
 const FINE_SHARP_M: f32 = 3.0;
+const GROUND_SHADOW_FOOTPRINT_M: f32 = 6.0;
 const NOISE_SIZE: f32 = 64.0;
 const NOISE_MAX_LOD: f32 = 5.0;
 const BLUE_NOISE_SIZE: u32 = 64u;
@@ -549,7 +550,7 @@ fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
     let dt = (seg.y - seg.x) / f32(n);
     var tau = 0.0;
     for (var i = 0u; i < n; i++) {
-        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), true, 0.0) * dt;
+        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), true, GROUND_SHADOW_FOOTPRINT_M) * dt;
     }
     return exp(-tau);
 }

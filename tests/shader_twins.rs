@@ -104,6 +104,10 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("FINE_FREQUENCY", density::FINE_FREQUENCY as f64),
         ("FINE_WEIGHT", density::FINE_WEIGHT as f64),
         ("FINE_SHARP_M", density::FINE_SHARP_M as f64),
+        (
+            "GROUND_SHADOW_FOOTPRINT_M",
+            renderer::GROUND_SHADOW_FOOTPRINT_M as f64,
+        ),
         ("NOISE_MAX_LOD", density::NOISE_MAX_LOD as f64),
         ("NOISE_SIZE", cumulus::render::noise_volume::SIZE as f64),
         ("BLUE_NOISE_SIZE", cumulus::render::sampling::SIZE as f64),

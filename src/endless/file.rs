@@ -47,7 +47,7 @@ pub fn fingerprint(scene: &Scene, cfg: &EndlessConfig) -> u64 {
         ..cfg.clone()
     };
     let text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{}|{:?}|{}|{}|{}|{}",
+        "{:?}|{:?}|{:?}|{:?}|{}|{:?}|{}|{}|{}|{}|{}",
         scene.atmosphere,
         scene.physics,
         scene.projection,
@@ -58,6 +58,7 @@ pub fn fingerprint(scene: &Scene, cfg: &EndlessConfig) -> u64 {
         r.detail_strength,
         r.detail_scale_m,
         r.extinction_per_m,
+        r.fine_detail,
     );
     text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
         (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)

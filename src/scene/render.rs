@@ -235,6 +235,20 @@ impl RenderSettings {
             ),
             range("render.coverage", f(r.coverage), 0.0, 1.0, "0..=1"),
             range(
+                "render.detail_strength",
+                f(r.detail_strength),
+                0.0,
+                1.0,
+                "0..=1",
+            ),
+            range(
+                "render.detail_scale_m",
+                f(r.detail_scale_m),
+                1.0,
+                1e5,
+                "1..=1e5 m",
+            ),
+            range(
                 "render.extinction_per_m",
                 f(r.extinction_per_m),
                 1e-6,

@@ -161,10 +161,12 @@ pub fn detail_billows(p: Vec3, scale_m: f32, footprint_m: f32, volume: &NoiseVol
 }
 
 /// The detail noise at world point `p` for features of `scale_m`, in
-/// `0..1`: the volume's base shape and billows weighted by
-/// [`BASE_WEIGHT`], each read at the mip level of a pixel footprint of
-/// `footprint_m` (far away, where a pixel covers many texels, the mips
-/// average the billows out instead of aliasing them).
+/// `0..1` (`±FINE_WEIGHT / 2` beyond with the fine billows): the
+/// volume's base shape and billows weighted by [`BASE_WEIGHT`], each read
+/// at the mip level of a pixel footprint of `footprint_m` (far away,
+/// where a pixel covers many texels, the mips average the billows out
+/// instead of aliasing them), and when `fine` the fine billows near the
+/// camera ([`detail_fine`]).
 #[inline]
 pub fn detail_noise(
     p: Vec3,
@@ -607,7 +609,7 @@ mod tests {
                 .map(|k| {
                     let k = k as f32;
                     let p = Vec3::new(k * 37.1, (k * 0.61).sin() * 900.0 + 1200.0, k * 13.7);
-                    detail_noise(p, 180.0, footprint, true, map.noise())
+                    detail_noise(p, 180.0, footprint, false, map.noise())
                 })
                 .collect();
             let mean = vals.iter().sum::<f32>() / n as f32;

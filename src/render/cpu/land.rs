@@ -9,10 +9,12 @@
 //!
 //! The woods are a threshold of the detail volume's base channel
 //! ([`crate::render::noise_volume`]) read on a horizontal slice at two
-//! scales, at the mip level of the pixel's footprint; the fields are
-//! parcels in rows, the rows of each farm (a block about 1.7 km across)
-//! on one of four headings, each row's fields of their own length, each
-//! parcel one of four crops by a hash of its cell. Where a pixel
+//! scales, at the mip level of the pixel's footprint, with a canopy of
+//! tree crowns placed by a hash; the fields are parcels in rows, the
+//! rows of each farm (a block about 1.7 km across) on one of four
+//! headings, each row's fields of their own length, each parcel one of
+//! four crops by a hash of its cell, in patches, behind hedges on most
+//! of its boundaries. Where a pixel
 //! covers more than half a field's width the parcels fade to their mean;
 //! the woods' edges soften as the footprint grows past 40 m, and from a
 //! footprint of 1 km to 2 km the woods fade to their share of the land,

@@ -382,18 +382,28 @@ pub fn flat_ground_shadow(origin: Vec3, dir: Vec3, sun_dir: Vec3, fr: &Frame) ->
 /// pixel, whatever `shadow_steps` the clouds' own light takes.
 pub const GROUND_SHADOW_STEPS: u32 = 12;
 
+/// The footprint the ground's cloud shadows read the density at, m
+/// (`GROUND_SHADOW_FOOTPRINT_M` in WGSL): twice
+/// [`super::density::FINE_SHARP_M`], so they read no fine billows (12
+/// samples across the band would only alias them), and at the default
+/// detail scale the finest mip level of everything else.
+pub const GROUND_SHADOW_FOOTPRINT_M: f32 = 2.0 * super::density::FINE_SHARP_M;
+
 /// Transmittance of the cloud band from a ground point `p` toward the sun:
 /// `steps` samples across the band segment of the sun ray, reading the
 /// detail noise as the clouds' own shadow rays do (without it the field
 /// near the base is wider than the cloud, and the shadows were large dark
-/// patches).
+/// patches), at [`GROUND_SHADOW_FOOTPRINT_M`].
 pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
     let Some((t0, t1)) = band_segment(p, sun_dir, d.band_bottom_m, d.band_top_m, 20_000.0) else {
         return 1.0;
     };
     let dt = (t1 - t0) / steps.max(1) as f32;
     let tau: f32 = (0..steps.max(1))
-        .map(|i| density_at(p + sun_dir * (t0 + (i as f32 + 0.5) * dt), f, d, true, 0.0) * dt)
+        .map(|i| {
+            let q = p + sun_dir * (t0 + (i as f32 + 0.5) * dt);
+            density_at(q, f, d, true, GROUND_SHADOW_FOOTPRINT_M) * dt
+        })
         .sum();
     (-tau).exp()
 }
