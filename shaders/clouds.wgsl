@@ -182,10 +182,16 @@ fn detail_base(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
 
 // The detail volume's billows channel (the CPU's `detail_billows`).
 fn detail_billows(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
+    return billows_channel(p, scale_m, footprint_m, BILLOW_FREQUENCY, vec3f(0.31, 0.17, 0.73));
+}
+
+// The billows channel at a multiple of the base's frequency (the CPU's
+// `billows_channel`).
+fn billows_channel(p: vec3f, scale_m: f32, footprint_m: f32, frequency: f32, offset: vec3f) -> f32 {
     let tile_m = DETAIL_TILE * scale_m;
     let texel_m = tile_m / NOISE_SIZE;
-    let lod = min(lod_of(footprint_m * BILLOW_FREQUENCY, texel_m), NOISE_MAX_LOD);
-    let q = p * (BILLOW_FREQUENCY / tile_m) + vec3f(0.31, 0.17, 0.73);
+    let lod = min(lod_of(footprint_m * frequency, texel_m), NOISE_MAX_LOD);
+    let q = p * (frequency / tile_m) + offset;
     return gained(textureSampleLevel(noise_tex, wrap_linear, q, lod).g, lod);
 }
 
@@ -203,11 +209,7 @@ fn detail_fine(p: vec3f, scale_m: f32, footprint_m: f32) -> f32 {
     if w <= 0.0 {
         return 0.0;
     }
-    let tile_m = DETAIL_TILE * scale_m;
-    let texel_m = tile_m / NOISE_SIZE;
-    let lod = min(lod_of(footprint_m * FINE_FREQUENCY, texel_m), NOISE_MAX_LOD);
-    let q = p * (FINE_FREQUENCY / tile_m) + vec3f(0.57, 0.11, 0.29);
-    return w * (gained(textureSampleLevel(noise_tex, wrap_linear, q, lod).g, lod) - 0.5);
+    return w * (billows_channel(p, scale_m, footprint_m, FINE_FREQUENCY, vec3f(0.57, 0.11, 0.29)) - 0.5);
 }
 
 // True where the coarse max-coverage mask says no P texel near map

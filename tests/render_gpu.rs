@@ -64,6 +64,18 @@ const PARITY_OUTLIERS: f64 = 0.002;
 /// detail noise; the mean stayed 0.0015).
 const PARITY_OUTLIERS_TERRAIN: f64 = 0.012;
 
+/// [`parity`] at 96x64 with the default bounds, the size most views use.
+fn parity_96x64(ctx: &GpuContext, sc: &Scene) {
+    parity(
+        ctx,
+        sc,
+        &[(96, 64)],
+        PARITY_MEAN,
+        PARITY_MAX,
+        PARITY_OUTLIERS,
+    );
+}
+
 fn parity(
     ctx: &GpuContext,
     sc: &Scene,
@@ -133,14 +145,7 @@ fn gpu_matches_cpu_reference_over_the_sea() {
     sc.render.sun_azimuth_deg = 180.0;
     sc.render.camera_yaw_deg = 180.0;
     sc.render.camera_pitch_deg = -10.0;
-    parity(
-        &ctx,
-        &sc,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &sc);
 }
 
 /// The fields and woods (`[render.ground] land`, on by default) seen from
@@ -159,26 +164,12 @@ fn gpu_matches_cpu_reference_on_the_fields() {
     // volume: it is uploaded for them.
     for detail in [sc.render.detail_strength, 0.0] {
         sc.render.detail_strength = detail;
-        parity(
-            &ctx,
-            &sc,
-            &[(96, 64)],
-            PARITY_MEAN,
-            PARITY_MAX,
-            PARITY_OUTLIERS,
-        );
+        parity_96x64(&ctx, &sc);
     }
     // Low over the land.
     sc.render.camera_position_m = [5230.0, 40.0, 4870.0];
     sc.render.camera_pitch_deg = -30.0;
-    parity(
-        &ctx,
-        &sc,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &sc);
     // Straight down from 25 m onto a hedge in the open (found with the CPU
     // twins), a tenth of the picture, and onto the woods' crowns.
     let prepared = Prepared::from_scene(&sc, || {}).expect("prepare");
@@ -200,23 +191,9 @@ fn gpu_matches_cpu_reference_on_the_fields() {
         .expect("a wood within 10 km");
     sc.render.camera_pitch_deg = -89.0;
     sc.render.camera_position_m = [wood, 25.0, 5000.0];
-    parity(
-        &ctx,
-        &sc,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &sc);
     sc.render.camera_position_m = [hedge, 25.0, 5000.0];
-    parity(
-        &ctx,
-        &sc,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &sc);
 }
 
 #[test]
@@ -224,41 +201,20 @@ fn gpu_matches_cpu_reference_above_and_inside_the_band() {
     let Some(ctx) = gpu() else { return };
     // strong_inversion looks down on the layer from above.
     let mut above = scene("strong_inversion");
-    parity(
-        &ctx,
-        &above,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &above);
     // The same without the fine billows near the camera (compiled out on
     // the GPU; this view's nearest tops have them: with the WGSL's left
     // in here, or taken out above, the mean doubles and 60 channels are
     // off by more than 0.05).
     above.render.fine_detail = false;
-    parity(
-        &ctx,
-        &above,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &above);
     // Flying through the clouds: the camera in the middle of the band.
     let mut inside = scene("fair_weather");
     let atm = inside.atmosphere(None).expect("atmosphere");
     let band = inside.band(&atm);
     inside.render.camera_position_m = [0.0, (0.5 * (band.bottom_m + band.top_m)) as f32, 0.0];
     inside.render.camera_pitch_deg = 0.0;
-    parity(
-        &ctx,
-        &inside,
-        &[(96, 64)],
-        PARITY_MEAN,
-        PARITY_MAX,
-        PARITY_OUTLIERS,
-    );
+    parity_96x64(&ctx, &inside);
 }
 
 /// With terrain, the GPU rasterises the heightfield as triangles where the
