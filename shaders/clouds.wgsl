@@ -37,6 +37,10 @@ const WARP_RAMP_OUTER: f32 = 1.3;
 const WEATHER_SCALE_M: f32 = 3000.0;
 const REFINE: u32 = 4u;
 const NEAR_M: f32 = 3000.0;
+// A band segment wider than MARCH_LOG_SPAN of ln(t + NEAR_M) takes more
+// steps, at most MARCH_STEP_FACTOR_MAX times (march_step_count).
+const MARCH_LOG_SPAN: f32 = 0.35;
+const MARCH_STEP_FACTOR_MAX: f32 = 4.0;
 const DETAIL_TILE: f32 = 4.0;
 const BILLOW_FREQUENCY: f32 = 1.618;
 const BASE_WEIGHT: f32 = 0.85;
@@ -761,6 +765,14 @@ fn march_distance(t0: f32, log_ratio: f32, s: f32) -> f32 {
     return (t0 + NEAR_M) * exp(s * log_ratio) - NEAR_M;
 }
 
+// The coarse steps of a band segment that spans log_ratio of
+// ln(t + NEAR_M): more where it is wider than MARCH_LOG_SPAN (the CPU's
+// `march_step_count`).
+fn march_step_count(steps: u32, log_ratio: f32) -> u32 {
+    let factor = clamp(log_ratio / MARCH_LOG_SPAN, 1.0, MARCH_STEP_FACTOR_MAX);
+    return u32(ceil(f32(max(steps, 1u)) * factor));
+}
+
 // The fitted ACES curve (the CPU's `aces_curve`).
 fn aces_curve(v: vec3f) -> vec3f {
     let a = v * (v + 0.0245786) - 0.000090537;
@@ -830,8 +842,8 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     let t0 = seg.x;
     let t1 = seg.y;
     let sun_dir = frame.sun_dir.xyz;
-    let steps = max(frame.counts.x, 1u);
     let log_ratio = log((t1 + NEAR_M) / (t0 + NEAR_M));
+    let steps = march_step_count(frame.counts.x, log_ratio);
     let spread = frame.cam_pos.w;
     let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
     let sky_top = sky_ambient(sun_dir) * 0.25;

@@ -89,8 +89,8 @@ fn march_volume(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
     }
     let t0 = seg.x;
     let sun_dir = frame.sun_dir.xyz;
-    let steps = max(frame.counts.x, 1u);
     let log_ratio = log((seg.y + NEAR_M) / (t0 + NEAR_M));
+    let steps = march_step_count(frame.counts.x, log_ratio);
     let cos_theta = dot(dir, sun_dir);
     let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
     let sky_top = sky_ambient(sun_dir) * 0.25;

@@ -17,7 +17,8 @@ use glam::{Vec3, Vec4};
 
 use super::density::band_segment;
 use super::lighting::{integrate_step, shadow_ray_length, sun_scattering};
-use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, NEAR_M, ambient_light, march_distance};
+use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, NEAR_M, ambient_light, march_distance,
+    march_step_count};
 use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
 use super::standalone::{analytic, hazed_clouds, render_standalone};
 
@@ -188,8 +189,8 @@ pub fn march_volume(
         return Vec4::ZERO;
     };
     let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
-    let steps = q.steps.max(1);
     let log_ratio = ((t1 + NEAR_M) / (t0 + NEAR_M)).ln();
+    let steps = march_step_count(q.steps, log_ratio);
     let cos = dir.dot(sun_dir);
     let sun = sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir);
     let sky_top = sky_ambient(sky, sun_dir) * 0.25;
