@@ -564,9 +564,13 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
 }
 
 /// Averaging the march over shifted sample offsets (the dither half of what
-/// `render.cpu_offsets` does for CPU pictures) takes the fixed dither's pattern out: at 24 steps,
-/// four offsets land at least a third closer to a 384-step image than one,
-/// and one offset is `render_linear` exactly.
+/// `render.cpu_offsets` does for CPU pictures) takes the fixed dither's pattern out: at 16 steps,
+/// four offsets land at least a third closer to a 384-step image than one
+/// (measured 0.59 times as far), and one offset is `render_linear` exactly.
+/// (At 24 steps it was a third until the horizon's grazing rays took more
+/// steps, 2026-12-05; now 0.71: the dither's part of the error is smaller
+/// there, and the rest, clouds that fall between the coarse steps' fixed
+/// ends, is the same for every offset.)
 #[test]
 fn averaged_offsets_approach_the_many_step_image() {
     use cumulus::prepare::Prepared;
@@ -591,12 +595,12 @@ fn averaged_offsets_approach_the_many_step_image() {
             .sum::<f64>()
             / (255.0 * b.len() as f64)
     };
-    let f24 = frame(24);
-    let one = render_linear_offsets(w, h, &f24, 1);
-    assert_eq!(one, render_linear(w, h, &f24));
-    let four = render_linear_offsets(w, h, &f24, 4);
+    let f16 = frame(16);
+    let one = render_linear_offsets(w, h, &f16, 1);
+    assert_eq!(one, render_linear(w, h, &f16));
+    let four = render_linear_offsets(w, h, &f16, 4);
     let (e1, e4) = (err(&one), err(&four));
-    eprintln!("24 steps: one offset {e1:.5}, four offsets {e4:.5} from 384 steps");
+    eprintln!("16 steps: one offset {e1:.5}, four offsets {e4:.5} from 384 steps");
     assert!(e4 < 0.67 * e1, "one offset {e1}, four {e4}");
 }
 
