@@ -303,13 +303,10 @@ fn world_footprint(x: f32, z: f32, l: vec3f, footprint_m: f32, eta: f32) -> vec4
 
 // The threshold the cloud field must exceed (the CPU's
 // `cumulus_threshold`): lowest just above the flat base, a dome rising to
-// 1 at the local top, and in the top tenth or so on to `ceiling`, the
-// field's highest value there, so no cloud is cut flat at the top.
-fn cumulus_threshold(eta: f32, top: f32, cover: f32, ceiling: f32) -> f32 {
+// 1 at the local top.
+fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
     let t = eta / top;
-    let t16a = ((t * t) * (t * t)) * ((t * t) * (t * t));
-    let t16 = t16a * t16a;
-    return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0) + (ceiling - 1.0) * t16;
+    return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0);
 }
 
 // The detail noise's weight, growing with height (the CPU's
@@ -382,8 +379,8 @@ fn density_at(p: vec3f, detail: bool, footprint_m: f32) -> f32 {
     if fp.x <= 0.0 || eta >= fp.y {
         return 0.0;
     }
+    let threshold = cumulus_threshold(eta, fp.y, fp.x);
     let s = erosion_strength(frame.map.y, eta, fp.y);
-    let threshold = cumulus_threshold(eta, fp.y, fp.x, cloud_field(1.0, 1.0, s));
     if cloud_field(fp.w, 1.0, s) < threshold {
         return 0.0;
     }

@@ -566,11 +566,12 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
 /// Averaging the march over shifted sample offsets (the dither half of what
 /// `render.cpu_offsets` does for CPU pictures) takes the fixed dither's pattern out: at 16 steps,
 /// four offsets land at least a third closer to a 384-step image than one
-/// (measured 0.59 times as far), and one offset is `render_linear` exactly.
-/// (At 24 steps it was a third until the horizon's grazing rays took more
-/// steps, 2026-12-05; now 0.71: the dither's part of the error is smaller
-/// there, and the rest, clouds that fall between the coarse steps' fixed
-/// ends, is the same for every offset.)
+/// (measured 0.60 times as far), and one offset is `render_linear` exactly.
+/// (The test ran at 24 steps until the horizon's grazing rays took more
+/// steps, 2026-12-05: there the dither's part of the error became small,
+/// and the rest, clouds that fall between the coarse steps' fixed ends,
+/// is the same for every offset, so four offsets gained less than a
+/// third.)
 #[test]
 fn averaged_offsets_approach_the_many_step_image() {
     use cumulus::prepare::Prepared;

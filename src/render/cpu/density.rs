@@ -460,21 +460,13 @@ pub fn world_footprint(
 /// The cumulus field's threshold at normalised height `eta` under a local
 /// top `top` where the parcels ask for a cloud fraction `cover`: the
 /// field must exceed it for cloud. Lowest just above the flat base (the
-/// widest part of a cumulus), rising as a dome `1 - (η/top)²` to 1 at the
-/// top, so the clouds that the field's high points make are flat-based
-/// and domed, taller where the field is higher; and in the top tenth or
-/// so, `(ceiling - 1) (η/top)¹⁶` more, up to `ceiling`, the highest value
-/// the field can take there (`cloud_field(1, 1, s)`, above 1 where the
-/// detail noise mixes in). Without that last part the field's peaks above
-/// 1 still had cloud at the top, where density_at cuts it off: a lid at
-/// `eta = top`, drawn as flat, straight-edged tops (seen from below near
-/// the horizon, a knife-cut line where the clouds meet the inversion).
+/// widest part of a cumulus), rising as a dome `1 - (η/top)²` to 1 (no
+/// cloud) at the top, so the clouds that the field's high points make
+/// are flat-based and domed, taller where the field is higher.
 #[inline]
-pub fn cumulus_threshold(eta: f32, top: f32, cover: f32, ceiling: f32) -> f32 {
+pub fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
     let t = eta / top;
-    let t16 = ((t * t) * (t * t)) * ((t * t) * (t * t));
-    let t16 = t16 * t16;
-    1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0) + (ceiling - 1.0) * t16
+    1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0)
 }
 
 /// Spread of [`detail_noise`] about its mean 0.5 is widened by this to
@@ -543,8 +535,8 @@ pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool, footprin
     if cover <= 0.0 || eta >= top {
         return 0.0;
     }
+    let threshold = cumulus_threshold(eta, top, cover);
     let s = erosion_strength(d.detail_strength, eta, top);
-    let threshold = cumulus_threshold(eta, top, cover, cloud_field(1.0, 1.0, s));
     // The highest the field can be here: skip the noise when even that
     // stays under the threshold.
     if cloud_field(m, 1.0, s) < threshold {
