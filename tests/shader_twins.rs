@@ -99,7 +99,10 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("REFINE", renderer::REFINE as f64),
         ("NEAR_M", renderer::NEAR_M as f64),
         ("MARCH_LOG_SPAN", renderer::MARCH_LOG_SPAN as f64),
-        ("MARCH_STEP_FACTOR_MAX", renderer::MARCH_STEP_FACTOR_MAX as f64),
+        (
+            "MARCH_STEP_FACTOR_MAX",
+            renderer::MARCH_STEP_FACTOR_MAX as f64,
+        ),
         ("DETAIL_TILE", density::DETAIL_TILE as f64),
         ("BILLOW_FREQUENCY", density::BILLOW_FREQUENCY as f64),
         ("BASE_WEIGHT", density::BASE_WEIGHT as f64),

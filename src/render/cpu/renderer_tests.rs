@@ -13,8 +13,7 @@ fn march_steps_span_the_segment_and_grow_with_distance() {
         assert!((march_distance(t0, lr, 0.0) - t0).abs() < 1e-3);
         assert!((march_distance(t0, lr, 1.0) - t1).abs() < 1e-3 * t1.max(1.0));
         let step = |i: u32| {
-            march_distance(t0, lr, (i + 1) as f32 / 48.0)
-                - march_distance(t0, lr, i as f32 / 48.0)
+            march_distance(t0, lr, (i + 1) as f32 / 48.0) - march_distance(t0, lr, i as f32 / 48.0)
         };
         let (first, last) = (step(0), step(47));
         assert!(first > 0.0 && last >= first, "{first} {last}");
@@ -66,7 +65,10 @@ fn grazing_rays_take_more_steps() {
     let (t0, t1) = segment(3.0);
     let (n, longest) = longest_step(t0, t1);
     assert!(n > 2 * steps, "{n}");
-    assert!(longest < 260.0, "longest coarse step {longest} m over {t0}-{t1} m");
+    assert!(
+        longest < 260.0,
+        "longest coarse step {longest} m over {t0}-{t1} m"
+    );
     for elevation in [45.0, 60.0, 90.0] {
         let (t0, t1) = segment(elevation);
         assert_eq!(longest_step(t0, t1).0, steps, "{elevation}°");
