@@ -70,13 +70,17 @@ fn tick_label(v: f64) -> String {
 /// The ticks of a log axis over `[lo, hi]`: labelled ones (every decade;
 /// also 2 and 5 times it when the axis spans under three decades, so
 /// that a short axis has labels everywhere, not only above its first
-/// power of ten) and unlabelled grid lines (1..9 times each decade).
+/// power of ten; every multiple 1..9 when it spans under one, so that a
+/// flat curve's axis is not left with one label) and unlabelled grid
+/// lines (the other multiples of each decade).
 fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
     let (lo, hi) = (lo.min(hi), lo.max(hi));
     if !(lo > 0.0 && hi.is_finite()) {
         return (Vec::new(), Vec::new());
     }
-    let steps: &[f64] = if hi / lo < 1000.0 {
+    let steps: &[f64] = if hi / lo < 10.0 {
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+    } else if hi / lo < 1000.0 {
         &[1.0, 2.0, 5.0]
     } else {
         &[1.0]
@@ -422,6 +426,11 @@ mod tests {
         let (bold, _) = log_ticks(1e-4, 300.0);
         assert_eq!(bold.len(), 7);
         assert!(log_ticks(0.0, 1.0).0.is_empty());
+        // Under a decade (a flat curve, 1.0 to 4.2 s): every multiple is
+        // labelled; the coverage plot's frame-time axis had one label.
+        let (bold, light) = log_ticks(980.0, 4200.0);
+        assert_eq!(bold, vec![1000.0, 2000.0, 3000.0, 4000.0]);
+        assert!(light.is_empty());
     }
 
     #[test]

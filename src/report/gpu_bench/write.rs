@@ -160,18 +160,22 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
                 .collect(),
         })
         .collect();
-    let marked: Vec<(f64, f64, String)> = report
-        .quality
-        .iter()
-        .filter(|q| q.is_default)
-        .map(|q| {
-            (
-                q.ms.max(1e-6),
-                q.mean_error.max(1e-6),
-                format!("  {} {}", q.knob, q.value),
-            )
-        })
-        .collect();
+    // The defaults, one ring each; those within 10 % of an earlier one in
+    // time and error (the same settings, measured in each knob's sweep)
+    // share its ring and label, whose three labels were drawn over each
+    // other.
+    let mut marked: Vec<(f64, f64, String)> = Vec::new();
+    for q in report.quality.iter().filter(|q| q.is_default) {
+        let (ms, error) = (q.ms.max(1e-6), q.mean_error.max(1e-6));
+        let near = |a: f64, b: f64| (a / b - 1.0).abs() < 0.1;
+        match marked
+            .iter_mut()
+            .find(|m| near(m.0, ms) && near(m.1, error))
+        {
+            Some(m) => m.2 = format!("{}, {} {}", m.2, q.knob, q.value),
+            None => marked.push((ms, error, format!("{} {}", q.knob, q.value))),
+        }
+    }
     loglog_png(
         &dir.join("render_error.png"),
         &format!(
