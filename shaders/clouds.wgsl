@@ -18,9 +18,11 @@ override DETAIL: bool = true;
 // with DETAIL.
 override FINE_DETAIL: bool = true;
 override DEBUG_COUNT: bool = false;
-// The sea below the horizon (else land), and its wind speed (m/s).
+// The sea below the horizon (else land), its wind speed (m/s) and the
+// direction the wind blows toward (degrees clockwise from north).
 override SEA: bool = false;
 override SEA_WIND_MPS: f32 = 7.0;
+override SEA_WIND_TOWARD_DEG: f32 = 90.0;
 // Fade clouds and ground with distance (`[render.atmosphere]
 // aerial_perspective`), read by the sky file's `aerial`.
 override AERIAL_PERSPECTIVE: bool = true;
@@ -96,6 +98,23 @@ const REFLECTION_STEPS_MAX: u32 = 16u;
 const REFLECTION_STEP_M: f32 = 300.0;
 const REFLECTION_SHADOW_STEPS: u32 = 2u;
 const REFLECTION_MIN_ELEVATION: f32 = 0.01;
+// The sea's wave trains (the CPU's waves.rs): how many, the octaves of
+// wavelength they span, the longest's wavelength (m), their directions' spread about the wind (radians), the
+// largest share of Cox and Munk's variance they carry, and the footprint
+// over wavelength over which a train fades from a pixel.
+const WAVE_COUNT: u32 = 40u;
+const WAVE_OCTAVES: f32 = 7.5;
+// Strata of the unresolved slopes the mirrored sky averages (the CPU's
+// sky.rs).
+const SKY_MIRROR_RAYS: u32 = 8u;
+const WAVE_LONGEST_M: f32 = 60.0;
+const WAVE_SPREAD: f32 = 0.96;
+const WAVE_SHARE_MAX: f32 = 0.8;
+const WAVE_FADE_START: f32 = 0.1;
+const WAVE_FADE_END: f32 = 0.5;
+// The most a pixel's footprint on the sea is longer along the line of
+// sight than across it, for the waves.
+const WAVE_ANISOTROPY_MAX: f32 = 4.0;
 // The golden ratio's fraction (the CPU's sampling::GOLDEN).
 const GOLDEN: f32 = 0.618034;
 // The clip depth at which rays are unprojected.
@@ -587,19 +606,108 @@ fn water_light(sun: vec3f, sun_dir: vec3f) -> vec3f {
         * (sun * (max(sun_dir.y, 0.0) / PI) + sky_ambient(sun_dir));
 }
 
-// The wind-roughened sea along `dir` (pointing down): the reflected sky,
-// the sun's glint (Cox-Munk slopes, Beckmann), the water's own blue, the
-// air in front (the CPU's `sea_radiance`).
-fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> vec3f {
+// Cox and Munk's mean square slope of a clean sea (the CPU's
+// `slope_variance`).
+fn slope_variance(wind_mps: f32) -> f32 {
+    return 0.003 + 0.00512 * max(wind_mps, 0.0);
+}
+
+// The mean square slope the wave trains carry: Cox and Munk's slick sea,
+// at most WAVE_SHARE_MAX of the clean one's (the CPU's `wave_variance`).
+fn wave_variance(wind_mps: f32) -> f32 {
+    let u = max(wind_mps, 0.0);
+    return min(0.008 + 0.00156 * u, WAVE_SHARE_MAX * slope_variance(u));
+}
+
+// The wave slope a pixel resolves at (x, z) and the slope variance it
+// does not: WAVE_COUNT trains over WAVE_OCTAVES of wavelength, each faded by the
+// pixel's footprint along it (the CPU's `sea_waves`).
+fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, toward_deg: f32) -> vec3f {
+    let total = slope_variance(wind_mps);
+    let share = wave_variance(wind_mps) / f32(WAVE_COUNT);
+    let amplitude = sqrt(2.0 * share);
+    var along = vec2f(0.0, 1.0);
+    if dot(dir.xz, dir.xz) > 0.0 {
+        along = normalize(dir.xz);
+    }
+    let along_m = ground_footprint(spread, t, dir.y);
+    let across_m = max(spread * t, along_m / WAVE_ANISOTROPY_MAX);
+    let wind = radians(toward_deg);
+    var slope = vec2f(0.0);
+    var resolved = 0.0;
+    for (var i = 0u; i < WAVE_COUNT; i++) {
+        let fi = f32(i);
+        let wavelength = WAVE_LONGEST_M * exp2(-WAVE_OCTAVES * fi / f32(WAVE_COUNT));
+        let turn = WAVE_SPREAD * (2.0 * fract((fi + 1.0) * GOLDEN) - 1.0);
+        let k = vec2f(sin(wind + turn), cos(wind + turn));
+        let cos_a = dot(k, along);
+        let sin_a = k.x * along.y - k.y * along.x;
+        let footprint = sqrt((along_m * cos_a) * (along_m * cos_a) + (across_m * sin_a) * (across_m * sin_a));
+        let w = 1.0 - smoothstep(WAVE_FADE_START, WAVE_FADE_END, footprint / wavelength);
+        if w <= 0.0 {
+            continue;
+        }
+        let phase = 2.0 * PI * ((x * k.x + z * k.y) / wavelength + fract((fi + 1.0) * GOLDEN * GOLDEN));
+        slope += k * (w * amplitude * cos(phase));
+        resolved += w * w * share;
+    }
+    return vec3f(slope, max(total - resolved, 1e-4));
+}
+
+// The waves where the ray meets the sea; the flat sea where it looks up,
+// the eye is under the sea or the sea lies beyond the rays' reach (the
+// CPU's `sea_waves_at`; only with SEA).
+fn sea_waves_at(origin: vec3f, dir: vec3f) -> vec3f {
+    if !SEA || dir.y >= 0.0 || origin.y <= 0.0 {
+        return flat_sea(SEA_WIND_MPS);
+    }
+    let t = origin.y / -dir.y;
+    if t > frame.sun_light.w {
+        return flat_sea(SEA_WIND_MPS);
+    }
+    return sea_waves(origin.x + dir.x * t, origin.z + dir.z * t, dir, frame.cam_pos.w, t, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG);
+}
+
+// No resolved slope, all of Cox and Munk's variance (the CPU's
+// `flat_sea`).
+fn flat_sea(wind_mps: f32) -> vec3f {
+    return vec3f(0.0, 0.0, slope_variance(wind_mps));
+}
+
+// The sea's normal under the resolved waves (the CPU's `wave_normal`).
+fn wave_normal(waves: vec3f) -> vec3f {
+    return normalize(vec3f(-waves.x, 1.0, -waves.y));
+}
+
+// The ray the sea sends up along `dir` under the resolved waves, at least
+// 1e-3 up (the CPU's `sea_mirror`).
+fn sea_mirror(dir: vec3f, waves: vec3f) -> vec3f {
+    let n = wave_normal(waves);
+    let r = dir - n * (2.0 * dot(dir, n));
+    return normalize_or(vec3f(r.x, max(r.y, 1e-3), r.z), vec3f(0.0, 1.0, 0.0));
+}
+
+// The sea's Fresnel reflectance under the resolved waves (the CPU's
+// `sea_fresnel`).
+fn sea_fresnel(dir: vec3f, waves: vec3f) -> f32 {
+    return fresnel_water(max(-dot(dir, wave_normal(waves)), 1e-3));
+}
+
+// The wind-roughened sea along `dir` (pointing down) under `waves`: the
+// sky mirrored by the resolved waves, the sun's glint (the unresolved
+// slopes about the resolved one, Beckmann), the water's own blue, the air
+// in front (the CPU's `sea_radiance`).
+fn sea_radiance(dir: vec3f, sun_dir: vec3f, waves: vec3f, shadow: f32, reflection: vec4f) -> vec3f {
     let mu = max(-dir.y, 1e-3);
-    let f = fresnel_water(mu);
-    let reflected = reflection.rgb + mirrored_sky(dir, sun_dir) * reflection.a;
+    let f = sea_fresnel(dir, waves);
+    let reflected = reflection.rgb + mirrored_sky(dir, waves, sun_dir) * reflection.a;
     let sun = sun_light_at(0.0, sun_dir) * shadow;
-    let variance = 0.003 + 0.00512 * max(SEA_WIND_MPS, 0.0);
+    let variance = waves.z;
     let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
     let cos_b = max(h.y, 1e-3);
-    let cos2 = cos_b * cos_b;
-    let d = exp(-(1.0 - cos2) / (cos2 * variance)) / (PI * variance * cos2 * cos2);
+    let tan2 = (h.x / cos_b + waves.x) * (h.x / cos_b + waves.x) + (h.z / cos_b + waves.y) * (h.z / cos_b + waves.y);
+    let cos2 = 1.0 / (1.0 + tan2);
+    let d = exp(-tan2 / variance) / (PI * variance * cos2 * cos2);
     var glint = vec3f(0.0);
     if sun_dir.y > 0.0 {
         glint = sun * (fresnel_water(dot(h, sun_dir)) * d / (4.0 * mu));
@@ -612,8 +720,8 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, reflection: vec4f) -> v
 // the flat sea's mirror ray rises at `mirror`, at the quantile `u` of the
 // waves' slopes: a logistic of Cox and Munk's deviation, cut off below
 // REFLECTION_MIN_ELEVATION (the CPU's `reflected_elevation`).
-fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
-    let deviation = sqrt(2.0 * (0.003 + 0.00512 * max(wind_mps, 0.0)));
+fn reflected_elevation(mirror: f32, variance: f32, u: f32) -> f32 {
+    let deviation = sqrt(2.0 * max(variance, 0.0));
     let s = deviation * sqrt(3.0) / PI;
     let lowest = 1.0 / (1.0 + exp((mirror - REFLECTION_MIN_ELEVATION) / s));
     let q = clamp(lowest + (1.0 - lowest) * u, 1e-6, 1.0 - 1e-6);
@@ -622,8 +730,8 @@ fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
 
 // A wave's slope across the line of sight at the quantile `u`: a logistic
 // of Cox and Munk's deviation in one direction (the CPU's `cross_slope`).
-fn cross_slope(wind_mps: f32, u: f32) -> f32 {
-    let deviation = sqrt(0.5 * (0.003 + 0.00512 * max(wind_mps, 0.0)));
+fn cross_slope(variance: f32, u: f32) -> f32 {
+    let deviation = sqrt(0.5 * max(variance, 0.0));
     let s = deviation * sqrt(3.0) / PI;
     let q = clamp(u, 1e-6, 1.0 - 1e-6);
     return s * log(q / (1.0 - q));
@@ -638,10 +746,20 @@ fn reflected_ray(across: vec3f, mirror: f32, e: f32, slope: f32) -> vec3f {
     return normalize(across * cos(e) + side * sideways + vec3f(0.0, sin(e), 0.0));
 }
 
-// The sky the flat sea mirrors along `dir` (the CPU's `mirrored_sky`).
-fn mirrored_sky(dir: vec3f, sun_dir: vec3f) -> vec3f {
-    let mu = max(-dir.y, 1e-3);
-    return sky_above(normalize_or(vec3f(dir.x, mu, dir.z), vec3f(0.0, 1.0, 0.0)), sun_dir);
+// The sky the sea mirrors along `dir` under the waves: the mean over
+// SKY_MIRROR_RAYS strata of the unresolved slopes about the resolved
+// waves' mirror ray (the CPU's `mirrored_sky`).
+fn mirrored_sky(dir: vec3f, waves: vec3f, sun_dir: vec3f) -> vec3f {
+    let r0 = sea_mirror(dir, waves);
+    let across = normalize_or(vec3f(r0.x, 0.0, r0.z), vec3f(0.0, 0.0, 1.0));
+    let mirror = asin(clamp(r0.y, -1.0, 1.0));
+    var sum = vec3f(0.0);
+    for (var k = 0u; k < SKY_MIRROR_RAYS; k++) {
+        let u = (f32(k) + 0.5) / f32(SKY_MIRROR_RAYS);
+        let e = reflected_elevation(mirror, waves.z, u);
+        sum += sky_above(reflected_ray(across, mirror, e, 0.0), sun_dir);
+    }
+    return sum / f32(SKY_MIRROR_RAYS);
 }
 
 // What the clouds the sea mirrors change in a sea pixel's radiance: the sea
@@ -652,8 +770,8 @@ fn sea_reflection_change(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f)
     if r.a >= 1.0 && all(r.rgb == vec3f(0.0)) {
         return vec3f(0.0);
     }
-    let f = fresnel_water(max(-dir.y, 1e-3));
-    return (r.rgb - mirrored_sky(dir, sun_dir) * (1.0 - r.a)) * f * ground_haze_transmittance(dir, sun_dir);
+    let waves = sea_waves_at(origin, dir);
+    return (r.rgb - mirrored_sky(dir, waves, sun_dir) * (1.0 - r.a)) * sea_fresnel(dir, waves) * ground_haze_transmittance(dir, sun_dir);
 }
 
 // The clouds the sea mirrors (rgb, premultiplied) and the reflected rays'
@@ -669,8 +787,12 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
         return vec4f(0.0, 0.0, 0.0, 1.0);
     }
     let p = vec3f(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
-    let across = normalize_or(vec3f(dir.x, 0.0, dir.z), vec3f(0.0, 0.0, 1.0));
-    let mirror = asin(clamp(-dir.y, -1.0, 1.0));
+    // The resolved waves' mirror ray; the slopes the pixel does not
+    // resolve spread the reflected rays about it.
+    let waves = sea_waves(p.x, p.z, dir, frame.cam_pos.w, t_sea, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG);
+    let r0 = sea_mirror(dir, waves);
+    let across = normalize_or(vec3f(r0.x, 0.0, r0.z), vec3f(0.0, 0.0, 1.0));
+    let mirror = asin(clamp(r0.y, -1.0, 1.0));
     let step_dither = fract(dither + GOLDEN);
     // What lights the mirrored clouds, the same for every reflected ray
     // (the CPU's ReflectionLight).
@@ -681,8 +803,8 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
     var sum = vec4f(0.0);
     for (var k = 0u; k < REFLECTION_RAYS; k++) {
         let u = (f32(k) + dither) / f32(REFLECTION_RAYS);
-        let e = reflected_elevation(mirror, SEA_WIND_MPS, u);
-        let slope = cross_slope(SEA_WIND_MPS, fract((f32(k) + 0.5) * GOLDEN + step_dither));
+        let e = reflected_elevation(mirror, waves.z, u);
+        let slope = cross_slope(waves.z, fract((f32(k) + 0.5) * GOLDEN + step_dither));
         let r = reflected_ray(across, mirror, e, slope);
         sum += reflected_clouds(p, r, t_sea, step_dither, sun_dir, sun, sky_top, ground, blur);
     }
@@ -745,12 +867,12 @@ fn ground_up(sun_dir: vec3f, sea: bool) -> vec3f {
 // The sky and the sun disk, or below the horizon the land (of albedo
 // `land`) or the sea in the clouds' shadow (the CPU's
 // `background_radiance`).
-fn background_radiance(dir: vec3f, sun_dir: vec3f, shadow: f32, land: vec3f, reflection: vec4f) -> vec3f {
+fn background_radiance(dir: vec3f, sun_dir: vec3f, waves: vec3f, shadow: f32, land: vec3f, reflection: vec4f) -> vec3f {
     if dir.y >= 0.0 {
         return sky_above(dir, sun_dir) + sun_disk(dir, sun_dir);
     }
     if SEA {
-        return sea_radiance(dir, sun_dir, shadow, reflection);
+        return sea_radiance(dir, sun_dir, waves, shadow, reflection);
     }
     return land_radiance(dir, sun_dir, shadow, land);
 }

@@ -15,6 +15,7 @@ use cumulus::render::cpu::renderer::{
 };
 use cumulus::render::cpu::sea::sea_reflection;
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};
+use cumulus::render::cpu::waves::sea_waves_at;
 use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, textures};
 use cumulus::scene::Scene;
@@ -326,7 +327,7 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
                 &frame.sky_light(),
                 dir,
                 sun,
-                q.sea_wind_mps,
+                sea_waves_at(view.eye(), dir, spread, &frame),
                 shadow,
                 flat_ground_albedo(view.eye(), dir, spread, &frame),
                 reflection,

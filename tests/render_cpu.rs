@@ -20,6 +20,7 @@ use cumulus::render::cpu::sea::{
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, LAND_ALBEDO, SkyModel, background_radiance, sun_direction, sun_light_at,
 };
+use cumulus::render::cpu::waves::{sea_waves_at, slope_variance};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
 
@@ -390,6 +391,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
             max_distance_m: 1e5,
             exposure: 1.0,
             sea_wind_mps: None,
+            sea_wind_toward_deg: 90.0,
             land_fields: false,
             atmosphere: AtmosphereConfig {
                 model: SkyModel::Analytic,
@@ -457,6 +459,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
             max_distance_m: 40_000.0,
             exposure: 1.2,
             sea_wind_mps: None,
+            sea_wind_toward_deg: 90.0,
             land_fields: false,
             atmosphere: AtmosphereConfig {
                 model: SkyModel::Analytic,
@@ -641,13 +644,13 @@ fn the_sea_mirrors_the_clouds_above_it() {
         let sky = fr.sky_light();
         let shadow = flat_ground_shadow(origin, dir, sun, &fr);
         let pixel = march_ray(origin, dir, 0.5, 1e-3, &fr).radiance;
-        let mirrored =
-            background_radiance(&sky, dir, sun, Some(7.0), shadow, LAND_ALBEDO, (light, t));
+        let waves = sea_waves_at(origin, dir, 1e-3, &fr);
+        let mirrored = background_radiance(&sky, dir, sun, waves, shadow, LAND_ALBEDO, (light, t));
         let bare = background_radiance(
             &sky,
             dir,
             sun,
-            Some(7.0),
+            waves,
             shadow,
             LAND_ALBEDO,
             (Vec3::ZERO, 1.0),
@@ -675,6 +678,41 @@ fn the_sea_mirrors_the_clouds_above_it() {
     );
 }
 
+/// The sea shows its waves where a pixel resolves them: seen from 30 m,
+/// 15° down, neighbouring pixels differ by several per cent (the resolved
+/// waves tilt the mirror and the Fresnel factor); 1° down, 1.7 km out,
+/// no wave is resolved and the sea is smooth. Until 2026-12-05 the sea
+/// was a function of the ray's direction alone, a smooth gradient near
+/// and far.
+#[test]
+fn the_sea_shows_its_waves_near_the_camera_and_not_far_off() {
+    let cm = cloud_map();
+    let clear = ProjectedField::new(32, 32);
+    let mut fr = small_frame(&clear, &cm);
+    fr.quality.sea_wind_mps = Some(7.0);
+    let origin = Vec3::new(0.0, 30.0, 0.0);
+    let sun = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    // A row of pixels 1 mrad apart, away from the sun.
+    let row = |down_deg: f32| -> f32 {
+        let e = down_deg.to_radians();
+        let l: Vec<f32> = (0..200)
+            .map(|i| {
+                let a = (-20.0 + 0.0573 * i as f32).to_radians();
+                let dir = Vec3::new(e.cos() * a.sin(), -e.sin(), -e.cos() * a.cos());
+                lum(march_ray(origin, dir, 0.5, 1e-3, &fr).radiance)
+            })
+            .collect();
+        let mean = l.iter().sum::<f32>() / l.len() as f32;
+        let step = l.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<f32>() / (l.len() - 1) as f32;
+        assert!(sun.y > 0.0 && mean > 0.0);
+        step / mean
+    };
+    let (near, far) = (row(15.0), row(1.0));
+    assert!(near > 0.02, "near: neighbours differ by {near}");
+    assert!(far < 0.002, "far: neighbours differ by {far}");
+}
+
 /// The waves turn the reflected ray up and down: its elevation spreads
 /// about the mirror ray's with the deviation √(2 · mean square slope) of
 /// Cox and Munk's slopes (0.28 rad at 7 m/s, 0.077 on a calm sea), and
@@ -689,7 +727,7 @@ fn the_waves_spread_the_reflected_rays_elevation() {
         // A high mirror ray: the spread is whole, centred on it.
         let mirror = 1.2;
         let e: Vec<f32> = (0..n)
-            .map(|i| reflected_elevation(mirror, wind, (i as f32 + 0.5) / n as f32))
+            .map(|i| reflected_elevation(mirror, slope_variance(wind), (i as f32 + 0.5) / n as f32))
             .collect();
         let mean = e.iter().sum::<f32>() / n as f32;
         let sd = (e.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / n as f32).sqrt();
@@ -705,7 +743,7 @@ fn the_waves_spread_the_reflected_rays_elevation() {
         assert!(e.windows(2).all(|w| w[1] >= w[0]));
         // A grazing mirror ray: the waves send it up, none of it down.
         for i in 0..n {
-            let low = reflected_elevation(0.005, wind, (i as f32 + 0.5) / n as f32);
+            let low = reflected_elevation(0.005, slope_variance(wind), (i as f32 + 0.5) / n as f32);
             assert!(
                 low >= REFLECTION_MIN_ELEVATION * 0.999,
                 "wind {wind}: {low}"
@@ -730,7 +768,7 @@ fn the_waves_turn_the_reflected_rays_sideways() {
     let n = 20_000;
     let wind = 7.0_f32;
     let s: Vec<f32> = (0..n)
-        .map(|i| cross_slope(wind, (i as f32 + 0.5) / n as f32))
+        .map(|i| cross_slope(slope_variance(wind), (i as f32 + 0.5) / n as f32))
         .collect();
     let mean = s.iter().sum::<f32>() / n as f32;
     let sd = (s.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / n as f32).sqrt();

@@ -12,7 +12,9 @@ use std::mem::offset_of;
 use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
-use cumulus::render::cpu::{density, land, light_volume, lighting, renderer, sea, sky, sky_luts};
+use cumulus::render::cpu::{
+    density, land, light_volume, lighting, renderer, sea, sky, sky_luts, waves,
+};
 use cumulus::render::gpu::light_volume_pass::{self, DiffusionGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
 use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
@@ -187,6 +189,15 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             sea::REFLECTION_MIN_ELEVATION as f64,
         ),
         ("GOLDEN", cumulus::render::sampling::GOLDEN as f64),
+        ("WAVE_COUNT", waves::WAVE_COUNT as f64),
+        ("WAVE_OCTAVES", waves::WAVE_OCTAVES as f64),
+        ("WAVE_ANISOTROPY_MAX", waves::WAVE_ANISOTROPY_MAX as f64),
+        ("SKY_MIRROR_RAYS", sky::SKY_MIRROR_RAYS as f64),
+        ("WAVE_LONGEST_M", waves::WAVE_LONGEST_M as f64),
+        ("WAVE_SPREAD", waves::WAVE_SPREAD as f64),
+        ("WAVE_SHARE_MAX", waves::WAVE_SHARE_MAX as f64),
+        ("WAVE_FADE_START", waves::WAVE_FADE_START as f64),
+        ("WAVE_FADE_END", waves::WAVE_FADE_END as f64),
         (
             "REFLECTION_SHADOW_STEPS",
             sea::REFLECTION_SHADOW_STEPS as f64,

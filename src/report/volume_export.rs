@@ -23,6 +23,7 @@ use crate::io::write_atomically;
 use crate::render::cpu::density::density_at;
 use crate::render::cpu::renderer::{ALBEDO, Frame};
 use crate::render::cpu::sky::{SkyLight, sea_radiance, sky_radiance, sun_direction, sun_light_at};
+use crate::render::cpu::waves::flat_sea;
 
 /// The largest number of cells along one axis.
 pub const MAX_CELLS: u32 = 2048;
@@ -295,7 +296,9 @@ pub fn sky_envmap(frame: &Frame, width: u32, height: u32) -> Vec<f32> {
         .flat_map(|(i, j)| {
             let d = envmap_direction(i, j, width, height);
             match frame.quality.sea_wind_mps {
-                Some(wind) if d.y < 0.0 => sea_radiance(sky, d, sun, wind, 1.0, (Vec3::ZERO, 1.0)),
+                Some(wind) if d.y < 0.0 => {
+                    sea_radiance(sky, d, sun, flat_sea(wind), 1.0, (Vec3::ZERO, 1.0))
+                }
                 _ => sky_radiance(sky, d, sun),
             }
             .to_array()

@@ -340,6 +340,13 @@ impl RenderSettings {
                 30.0,
                 "0..=30 m/s",
             ),
+            range(
+                "render.ground.wind_direction_deg",
+                f(r.ground.wind_direction_deg),
+                -360.0,
+                360.0,
+                "-360..=360 degrees",
+            ),
             Check::new(
                 "render.terrain.size",
                 (16..=2048).contains(&r.terrain.size),
@@ -411,6 +418,7 @@ impl RenderSettings {
             max_distance_m: self.max_distance_m,
             exposure: self.exposure,
             sea_wind_mps: self.ground.sea_wind_mps(),
+            sea_wind_toward_deg: self.ground.wind_direction_deg,
             land_fields: self.ground.land_fields(),
             atmosphere: self.atmosphere,
             single_scattering: false,

@@ -19,3 +19,4 @@ pub mod spheroids;
 pub mod standalone;
 pub mod tone_map;
 pub mod volume;
+pub mod waves;

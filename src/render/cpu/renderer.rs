@@ -22,6 +22,7 @@ use super::sky::{
 };
 use super::sky_luts::SkyLuts;
 pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
+use super::waves::sea_waves_at;
 use crate::render::camera::View;
 use crate::render::sampling::{self, frame_offset, jitter};
 use crate::render::terrain::Heightfield;
@@ -46,6 +47,9 @@ pub struct Quality {
     /// The sea below the horizon with this wind speed, m/s (`None`:
     /// land; [`super::sky::background_radiance`]).
     pub sea_wind_mps: Option<f32>,
+    /// The direction the sea's wind blows toward, degrees clockwise from
+    /// north: the waves run along it ([`super::waves::sea_waves`]).
+    pub sea_wind_toward_deg: f32,
     /// The land drawn as fields and woods
     /// ([`super::land::land_albedo`]); off: one colour,
     /// [`super::sky::LAND_ALBEDO`]. Off under the sea.
@@ -232,7 +236,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
                 sky,
                 dir,
                 sun_dir,
-                q.sea_wind_mps,
+                sea_waves_at(origin, dir, spread, fr),
                 flat_ground_shadow(origin, dir, sun_dir, fr),
                 flat_ground_albedo(origin, dir, spread, fr),
                 (Vec3::ZERO, 1.0),

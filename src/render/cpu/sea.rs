@@ -18,8 +18,10 @@ use super::renderer::{
     ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, cloud_shadow, diffused_light,
 };
 use super::sky::{
-    fresnel_water, ground_haze_transmittance, ground_up, mirrored_sky, sky_ambient, sun_light_at,
+    ground_haze_transmittance, ground_up, mirrored_sky, sea_fresnel, sea_mirror, sky_ambient,
+    sun_light_at,
 };
+use super::waves::{sea_waves, sea_waves_at};
 use crate::render::sampling::GOLDEN;
 
 /// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
@@ -62,23 +64,25 @@ pub const REFLECTION_SHADOW_STEPS: u32 = 2;
 pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
 
 /// The elevation (radians) of a ray the wind-roughened sea reflects,
-/// where the flat sea's mirror ray rises at `mirror` radians, at the
-/// quantile `u` in `(0, 1)` of the waves' slopes.
+/// where the mirror ray of the waves the pixel resolves rises at `mirror`
+/// radians, at the quantile `u` in `(0, 1)` of the slopes it does not,
+/// of mean square `variance` (both directions together;
+/// [`super::waves::sea_waves`]).
 ///
 /// A facet tilted by a slope `s` toward or away from the viewer turns
 /// the reflected ray up or down by `2 s` (sideways tilts turn it in
-/// azimuth: [`cross_slope`], [`reflected_ray`]). Cox and Munk's (1954)
-/// mean square slope `0.003 + 0.00512 U` for a wind of `U` m/s is split
-/// between the two directions, so the
-/// elevation spreads with a standard deviation of `√(2 · that)`: 0.28 rad
-/// (16°) at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
+/// azimuth: [`cross_slope`], [`reflected_ray`]). The mean square slope
+/// (far away all of Cox and Munk's 1954 `0.003 + 0.00512 U` for a wind
+/// of `U` m/s) is split between the two directions, so the
+/// elevation spreads with a standard deviation of `√(2 · variance)`: 0.28
+/// rad (16°) far out at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
 /// distribution of that deviation (its quantile in closed form; its
 /// cumulative distribution within 0.02 of a Gaussian's), cut off below
 /// [`REFLECTION_MIN_ELEVATION`]: the waves draw a mirrored cloud out
 /// into a vertical smear, near the horizon only upward.
 #[inline]
-pub fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
-    let deviation = (2.0 * (0.003 + 0.00512 * wind_mps.max(0.0))).sqrt();
+pub fn reflected_elevation(mirror: f32, variance: f32, u: f32) -> f32 {
+    let deviation = (2.0 * variance.max(0.0)).sqrt();
     // A logistic of scale s has the deviation s·π/√3.
     let s = deviation * 3f32.sqrt() / PI;
     let lowest = 1.0 / (1.0 + ((mirror - REFLECTION_MIN_ELEVATION) / s).exp());
@@ -87,12 +91,12 @@ pub fn reflected_elevation(mirror: f32, wind_mps: f32, u: f32) -> f32 {
 }
 
 /// A wave's slope across the line of sight at the quantile `u` in `(0,
-/// 1)`, in a wind of `wind_mps`: a logistic of Cox and Munk's deviation
-/// in one direction, `√((0.003 + 0.00512 U) / 2)` (0.14 at 7 m/s), as
-/// [`reflected_elevation`]'s slopes along it.
+/// 1)`, of the slopes of mean square `variance` a pixel does not resolve:
+/// a logistic of their deviation in one direction, `√(variance / 2)`
+/// (far out 0.14 at 7 m/s), as [`reflected_elevation`]'s slopes along it.
 #[inline]
-pub fn cross_slope(wind_mps: f32, u: f32) -> f32 {
-    let deviation = (0.5 * (0.003 + 0.00512 * wind_mps.max(0.0))).sqrt();
+pub fn cross_slope(variance: f32, u: f32) -> f32 {
+    let deviation = (0.5 * variance.max(0.0)).sqrt();
     let s = deviation * 3f32.sqrt() / PI;
     let q = u.clamp(1e-6, 1.0 - 1e-6);
     s * (q / (1.0 - q)).ln()
@@ -148,8 +152,12 @@ pub fn sea_reflection(
         return (Vec3::ZERO, 1.0);
     }
     let p = Vec3::new(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
-    let across = Vec3::new(dir.x, 0.0, dir.z).normalize_or(Vec3::Z);
-    let mirror = (-dir.y).clamp(-1.0, 1.0).asin();
+    // The mirror ray of the waves the pixel resolves; the slopes it does
+    // not spread the reflected rays about it.
+    let waves = sea_waves(p.x, p.z, dir, spread, t_sea, wind, q.sea_wind_toward_deg);
+    let r0 = sea_mirror(dir, waves);
+    let across = Vec3::new(r0.x, 0.0, r0.z).normalize_or(Vec3::Z);
+    let mirror = r0.y.clamp(-1.0, 1.0).asin();
     // The steps' placement within a ray, apart from the strata's shift.
     let step_dither = (dither + GOLDEN).fract();
     let light_in = ReflectionLight::new(fr, sun_dir, wind);
@@ -157,10 +165,10 @@ pub fn sea_reflection(
     let mut transmittance = 0.0;
     for k in 0..REFLECTION_RAYS {
         let u = (k as f32 + dither) / REFLECTION_RAYS as f32;
-        let e = reflected_elevation(mirror, wind, u);
+        let e = reflected_elevation(mirror, waves.z, u);
         // The sideways slopes in golden-ratio steps, apart from the
         // elevation's strata.
-        let slope = cross_slope(wind, ((k as f32 + 0.5) * GOLDEN + step_dither).fract());
+        let slope = cross_slope(waves.z, ((k as f32 + 0.5) * GOLDEN + step_dither).fract());
         let r = reflected_ray(across, mirror, e, slope);
         let (l, t) = reflected_clouds(p, r, t_sea, step_dither, sun_dir, &light_in, spread, fr);
         light += l;
@@ -207,9 +215,10 @@ impl ReflectionLight {
 /// radiance of a sea pixel along `dir`: [`super::sky::sea_radiance`] with them less
 /// without them, `(L - S (1 - T)) · F · T_air` for the clouds' light `L`
 /// and transmittance `T`, the mirrored sky `S` ([`mirrored_sky`]), the
-/// Fresnel factor `F` and the air's transmittance `T_air`
+/// Fresnel factor `F` ([`sea_fresnel`]; both under the waves the pixel
+/// resolves, [`sea_waves_at`]) and the air's transmittance `T_air`
 /// ([`ground_haze_transmittance`]); zero where nothing is mirrored. The
-/// sky `S` the clouds hide is the flat mirror's, though the reflected
+/// sky `S` the clouds hide is the resolved waves' mirror's, though the reflected
 /// rays that meet them rise higher: near the horizon, where the mirrored
 /// sky is brightest, the change is somewhat too dark.
 /// The GPU adds it to the cloud layer in the cloud pass (under the
@@ -227,10 +236,12 @@ pub fn sea_reflection_change(
     if transmittance >= 1.0 && light == Vec3::ZERO {
         return Vec3::ZERO;
     }
+    let Some(waves) = sea_waves_at(origin, dir, spread, fr) else {
+        return Vec3::ZERO;
+    };
     let sky = &fr.sky_light();
-    let f = fresnel_water((-dir.y).max(1e-3));
-    (light - mirrored_sky(sky, dir, sun_dir) * (1.0 - transmittance))
-        * f
+    (light - mirrored_sky(sky, dir, waves, sun_dir) * (1.0 - transmittance))
+        * sea_fresnel(dir, waves)
         * ground_haze_transmittance(sky, dir, sun_dir)
 }
 

@@ -22,9 +22,11 @@ use serde::{Deserialize, Serialize};
 
 use super::lighting::phase_hg;
 use super::renderer::SUN_INTENSITY;
+use super::sea::{reflected_elevation, reflected_ray};
 use super::sky_luts::{
     SkyLuts, SkyParams, aerial_perspective, sky_view_radiance, sun_disk_radiance, sun_radiance_at,
 };
+use super::waves::wave_normal;
 
 /// Cosine of the analytic sun disk's angular radius (0.27°).
 pub const SUN_DISK_COS: f32 = 0.999_989;
@@ -367,6 +369,10 @@ pub struct GroundConfig {
     /// Wind speed over the sea, m/s (0..=30): the roughness of its waves,
     /// so the width of the sun's glint. Default 7.
     pub wind_speed_mps: f32,
+    /// The direction the sea's wind blows toward, degrees clockwise from
+    /// north (+z), as `[physics.wind] direction_deg`: the waves run
+    /// along it ([`super::waves::sea_waves`]). Default 90 (east).
+    pub wind_direction_deg: f32,
 }
 
 impl Default for GroundConfig {
@@ -375,6 +381,7 @@ impl Default for GroundConfig {
             surface: Surface::Land,
             land: Land::Fields,
             wind_speed_mps: 7.0,
+            wind_direction_deg: 90.0,
         }
     }
 }
@@ -412,24 +419,67 @@ fn water_light(sky: &SkyLight, sun: Vec3, sun_dir: Vec3) -> Vec3 {
     Vec3::new(0.004, 0.012, 0.02) * (sun * (sun_dir.y.max(0.0) / PI) + sky_ambient(sky, sun_dir))
 }
 
-/// The sky the flat sea mirrors along `dir` (pointing down).
+/// The ray the sea sends up where `dir` (pointing down) meets it, tilted
+/// by the resolved `waves` ([`super::waves::sea_waves`]): the mirror
+/// image of `dir` about [`wave_normal`], at least 1e-3 up (a facet that
+/// would send it down sends it into the next wave, which sends it up).
+/// The flat sea's mirror ray with no slope.
 #[inline]
-pub fn mirrored_sky(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
-    let mu = (-dir.y).max(1e-3);
-    sky_above(
-        sky,
-        Vec3::new(dir.x, mu, dir.z).normalize_or(Vec3::Y),
-        sun_dir,
-    )
+pub fn sea_mirror(dir: Vec3, waves: Vec3) -> Vec3 {
+    let n = wave_normal(waves);
+    let r = dir - n * (2.0 * dir.dot(n));
+    Vec3::new(r.x, r.y.max(1e-3), r.z).normalize_or(Vec3::Y)
 }
 
-/// Radiance of a wind-roughened sea seen along `dir` (pointing down):
-/// - the sky reflected by the mean flat surface, weighted by
-///   [`fresnel_water`] (so the sea darkens looking down and mirrors the
-///   pale horizon sky toward the horizon);
-/// - the sun's glint: a microfacet reflection whose facet slopes have the
-///   variance Cox and Munk (1954) measured, `0.003 + 0.00512·U` for a wind
-///   of `U` m/s, as a Beckmann distribution, `E F D / (4 cos θ_v)`;
+/// The Fresnel reflectance of the sea seen along `dir` under the resolved
+/// `waves`: [`fresnel_water`] at the angle to [`wave_normal`].
+#[inline]
+pub fn sea_fresnel(dir: Vec3, waves: Vec3) -> f32 {
+    fresnel_water((-dir.dot(wave_normal(waves))).max(1e-3))
+}
+
+/// The strata of the slopes a pixel does not resolve over which the sea's
+/// mirrored sky is averaged ([`mirrored_sky`]; `SKY_MIRROR_RAYS` in WGSL).
+pub const SKY_MIRROR_RAYS: u32 = 8;
+
+/// The sky the sea mirrors along `dir` (pointing down), under `waves`:
+/// the mean of the sky along [`SKY_MIRROR_RAYS`] rays about the resolved
+/// waves' mirror ray ([`sea_mirror`]), one at the middle of each stratum
+/// of the slopes the pixel does not resolve
+/// ([`super::sea::reflected_elevation`]; turned up or down, not
+/// sideways, since the sky changes little in azimuth). A flat mirror
+/// (until 2026-12-05) showed the far sea as bright as the sky at the
+/// horizon: its rough waves send the reflected rays on average 10-15°
+/// up, to a deeper sky, and the waves drawn near the camera, which do,
+/// met it in a visible step.
+#[inline]
+pub fn mirrored_sky(sky: &SkyLight, dir: Vec3, waves: Vec3, sun_dir: Vec3) -> Vec3 {
+    let r0 = sea_mirror(dir, waves);
+    let across = Vec3::new(r0.x, 0.0, r0.z).normalize_or(Vec3::Z);
+    let mirror = r0.y.clamp(-1.0, 1.0).asin();
+    let mut sum = Vec3::ZERO;
+    for k in 0..SKY_MIRROR_RAYS {
+        let u = (k as f32 + 0.5) / SKY_MIRROR_RAYS as f32;
+        let e = reflected_elevation(mirror, waves.z, u);
+        sum += sky_above(sky, reflected_ray(across, mirror, e, 0.0), sun_dir);
+    }
+    sum / SKY_MIRROR_RAYS as f32
+}
+
+/// Radiance of a wind-roughened sea seen along `dir` (pointing down),
+/// under `waves` (`(slope x, slope z, variance)`:
+/// [`super::waves::sea_waves`], the slope a pixel resolves and the
+/// variance it does not; [`super::waves::flat_sea`] far away):
+/// - the sky mirrored about the resolved waves' normal
+///   ([`mirrored_sky`]), weighted by the Fresnel factor at it
+///   ([`sea_fresnel`]; so the sea darkens looking down and mirrors the
+///   pale horizon sky toward the horizon, and near the camera the waves'
+///   faces turned up or away show as darker or paler);
+/// - the sun's glint: a microfacet reflection whose facet slopes spread
+///   about the resolved slope with the unresolved variance (in all, Cox
+///   and Munk's 1954 `0.003 + 0.00512·U` for a wind of `U` m/s), as a
+///   Beckmann distribution in slope space, `E F D / (4 cos θ_v)`: a
+///   broad glint far away, glitter on the waves near the camera;
 /// - the water's own light: a deep-blue albedo (0.004, 0.012, 0.02) lit
 ///   by the sun and the zenith sky, through the surface (1 - F);
 ///
@@ -444,19 +494,21 @@ pub fn sea_radiance(
     sky: &SkyLight,
     dir: Vec3,
     sun_dir: Vec3,
-    wind_mps: f32,
+    waves: Vec3,
     shadow: f32,
     reflection: (Vec3, f32),
 ) -> Vec3 {
     let mu = (-dir.y).max(1e-3);
-    let f = fresnel_water(mu);
-    let reflected = reflection.0 + mirrored_sky(sky, dir, sun_dir) * reflection.1;
+    let f = sea_fresnel(dir, waves);
+    let reflected = reflection.0 + mirrored_sky(sky, dir, waves, sun_dir) * reflection.1;
     let sun = sun_light_at(sky, 0.0, sun_dir) * shadow;
-    let variance = 0.003 + 0.00512 * wind_mps.max(0.0);
+    let variance = waves.z;
     let h = (sun_dir - dir).normalize_or(Vec3::Y);
     let cos_b = h.y.max(1e-3);
-    let cos2 = cos_b * cos_b;
-    let d = (-(1.0 - cos2) / (cos2 * variance)).exp() / (PI * variance * cos2 * cos2);
+    // The half vector's facet slope less the resolved slope.
+    let tan2 = (h.x / cos_b + waves.x).powi(2) + (h.z / cos_b + waves.y).powi(2);
+    let cos2 = 1.0 / (1.0 + tan2);
+    let d = (-tan2 / variance).exp() / (PI * variance * cos2 * cos2);
     let glint = if sun_dir.y > 0.0 {
         sun * (fresnel_water(h.dot(sun_dir)) * d / (4.0 * mu))
     } else {
@@ -482,16 +534,17 @@ pub fn ground_up(sky: &SkyLight, sun_dir: Vec3, sea: bool) -> Vec3 {
 
 /// What a ray that meets no terrain sees along `dir`: the sky and the sun
 /// disk, or below the horizon the land ([`land_radiance`]) or, with
-/// `sea_wind_mps`, the sea ([`sea_radiance`], mirroring the clouds of
-/// `reflection`), in the clouds' `shadow` where the ray meets them; the
-/// land of albedo `land` there ([`LAND_ALBEDO`], or the fields'
+/// `sea` (its waves there, [`super::waves::sea_waves`]), the sea
+/// ([`sea_radiance`], mirroring the clouds of `reflection`), in the
+/// clouds' `shadow` where the ray meets them; the land of albedo `land`
+/// there ([`LAND_ALBEDO`], or the fields'
 /// [`super::land::flat_ground_albedo`]).
 #[inline]
 pub fn background_radiance(
     sky: &SkyLight,
     dir: Vec3,
     sun_dir: Vec3,
-    sea_wind_mps: Option<f32>,
+    sea: Option<Vec3>,
     shadow: f32,
     land: Vec3,
     reflection: (Vec3, f32),
@@ -499,8 +552,8 @@ pub fn background_radiance(
     if dir.y >= 0.0 {
         return sky_above(sky, dir, sun_dir) + sun_disk(sky, dir, sun_dir);
     }
-    match sea_wind_mps {
-        Some(wind) => sea_radiance(sky, dir, sun_dir, wind, shadow, reflection),
+    match sea {
+        Some(waves) => sea_radiance(sky, dir, sun_dir, waves, shadow, reflection),
         None => land_radiance(sky, dir, sun_dir, shadow, land),
     }
 }

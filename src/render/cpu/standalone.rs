@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use super::renderer::Frame;
 use super::sky::{LAND_ALBEDO, SkyLight, aerial, background_radiance, sun_direction};
+use super::waves::sea_waves_at;
 use crate::render::sampling::frame_offset;
 
 /// The sky a stand-alone pass draws under: the frame's, analytic, over
@@ -69,6 +70,7 @@ pub fn render_standalone(
     let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
     let sky = &analytic(fr);
     let w = width as usize;
+    let spread = fr.view.pixel_spread(width, height);
     let mut out = vec![Vec3::ZERO; w * height as usize];
     out.par_chunks_mut(w.max(1))
         .enumerate()
@@ -86,7 +88,7 @@ pub fn render_standalone(
                     sky,
                     dir,
                     sun_dir,
-                    fr.quality.sea_wind_mps,
+                    sea_waves_at(fr.view.eye(), dir, spread, fr),
                     1.0,
                     LAND_ALBEDO,
                     (Vec3::ZERO, 1.0),

@@ -82,6 +82,10 @@ impl GpuSettings {
                 "SEA_WIND_MPS",
                 self.quality.sea_wind_mps.unwrap_or_default() as f64,
             ),
+            (
+                "SEA_WIND_TOWARD_DEG",
+                self.quality.sea_wind_toward_deg as f64,
+            ),
         ]
     }
 }

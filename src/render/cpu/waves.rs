@@ -1,0 +1,248 @@
+//! The sea's waves a pixel resolves: a sum of wave trains whose slopes
+//! tilt the sea's normal where a pixel is smaller than them (near the
+//! camera), and whose slopes a pixel cannot resolve stay in the glint's
+//! statistical roughness (far away), so the two together always hold
+//! Cox and Munk's (1954) slope variance. Twins of the WGSL functions of
+//! the same names in `shaders/clouds.wgsl`.
+//!
+//! The waves are fixed in space (no time): they stand still under a
+//! camera that moves, and the demo's sea does not ripple.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use super::land::ground_footprint;
+use super::renderer::Frame;
+use crate::render::sampling::GOLDEN;
+
+/// Wave trains summed (`WAVE_COUNT` in WGSL), their wavelengths evenly
+/// spread in ratio over [`WAVE_OCTAVES`] below [`WAVE_LONGEST_M`], about
+/// five an octave. With two an octave (15 trains) the few a pixel
+/// resolves from 300 m up made a lattice of diamonds, and seen at a
+/// grazing angle the long crests across the line of sight ran to the
+/// vanishing point as straight lines: more trains in more directions
+/// make short crests.
+pub const WAVE_COUNT: u32 = 40;
+/// The octaves of wavelength the trains span (`WAVE_OCTAVES`): 60 m down
+/// to 0.35 m.
+pub const WAVE_OCTAVES: f32 = 7.5;
+/// The longest train's wavelength, m (`WAVE_LONGEST_M`): about the
+/// dominant wave of a 7 m/s wind's sea (its peak wavelength,
+/// `2π (1.2 U)² / g`, is 45 m).
+pub const WAVE_LONGEST_M: f32 = 60.0;
+/// How far the trains' directions spread to either side of the wind,
+/// radians (`WAVE_SPREAD`, about 55°): wind seas are short-crested.
+pub const WAVE_SPREAD: f32 = 0.96;
+/// The largest share of Cox and Munk's variance the trains carry
+/// (`WAVE_SHARE_MAX`): in a calm their slick-sea fit exceeds the clean
+/// one, and the capillaries always keep some.
+pub const WAVE_SHARE_MAX: f32 = 0.8;
+/// A train fades from a pixel between this and [`WAVE_FADE_END`] of its
+/// wavelength across the pixel's footprint along it
+/// (`WAVE_FADE_START`): past half a wavelength it would alias.
+pub const WAVE_FADE_START: f32 = 0.1;
+/// See [`WAVE_FADE_START`] (`WAVE_FADE_END`).
+pub const WAVE_FADE_END: f32 = 0.5;
+
+/// The most a pixel's footprint on the sea may be longer along the line
+/// of sight than across it, for the waves (`WAVE_ANISOTROPY_MAX`): seen
+/// at a grazing angle (20:1 at 3°) the trains whose crests run along the
+/// line of sight stayed resolved long after those across it faded, and
+/// their long straight crests ran to the vanishing point like a zoom
+/// blur. The waves across the line of sight fade sooner instead.
+pub const WAVE_ANISOTROPY_MAX: f32 = 4.0;
+
+/// Cox and Munk's (1954) mean square slope of a clean sea in a wind of
+/// `wind_mps` (both directions together): `0.003 + 0.00512 U`.
+#[inline]
+pub fn slope_variance(wind_mps: f32) -> f32 {
+    0.003 + 0.00512 * wind_mps.max(0.0)
+}
+
+/// The mean square slope the wave trains carry: Cox and Munk's fit for a
+/// sea whose capillaries and short waves an oil slick has damped,
+/// `0.008 + 0.00156 U` (about half of the clean sea's at 7 m/s, waves
+/// longer than some decimetres), at most [`WAVE_SHARE_MAX`] of
+/// [`slope_variance`].
+#[inline]
+pub fn wave_variance(wind_mps: f32) -> f32 {
+    let u = wind_mps.max(0.0);
+    (0.008 + 0.00156 * u).min(WAVE_SHARE_MAX * slope_variance(u))
+}
+
+/// The wave slope `(∂h/∂x, ∂h/∂z)` a pixel resolves at `(x, z)` on the
+/// sea and the slope variance it does not (the glint's roughness), as
+/// `(slope x, slope z, variance)`, for a wind of `wind_mps` blowing
+/// toward `toward_deg` (clockwise from north, +z), seen along `dir` (down)
+/// by a pixel of cone angle `spread` at distance `t`.
+///
+/// Train `i` has wavelength `WAVE_LONGEST_M · 2^{-WAVE_OCTAVES · i / WAVE_COUNT}`, a direction
+/// spread about the wind's by the golden-ratio sequence and a phase the
+/// same, and an equal share of [`wave_variance`] (a saturated sea's
+/// slopes spread evenly over the wavenumbers' octaves). Its weight in the
+/// pixel fades with the pixel's footprint along it (its width across the
+/// line of sight, `spread · t` but at least [`WAVE_ANISOTROPY_MAX`]-th of
+/// its length, and along it, [`ground_footprint`]); the
+/// variance it loses, and all of [`slope_variance`] that the trains do not
+/// carry, is the unresolved variance. Far away that is the whole of
+/// [`slope_variance`] and the slope 0: the flat, rough sea.
+pub fn sea_waves(
+    x: f32,
+    z: f32,
+    dir: Vec3,
+    spread: f32,
+    t: f32,
+    wind_mps: f32,
+    toward_deg: f32,
+) -> Vec3 {
+    let total = slope_variance(wind_mps);
+    let share = wave_variance(wind_mps) / WAVE_COUNT as f32;
+    let amplitude = (2.0 * share).sqrt();
+    let along = Vec2::new(dir.x, dir.z).normalize_or(Vec2::Y);
+    let along_m = ground_footprint(spread, t, dir.y);
+    let across_m = (spread * t).max(along_m / WAVE_ANISOTROPY_MAX);
+    let wind = toward_deg.to_radians();
+    let mut slope = Vec2::ZERO;
+    let mut resolved = 0.0;
+    for i in 0..WAVE_COUNT {
+        let fi = i as f32;
+        let wavelength = WAVE_LONGEST_M * (-WAVE_OCTAVES * fi / WAVE_COUNT as f32).exp2();
+        let turn = WAVE_SPREAD * (2.0 * ((fi + 1.0) * GOLDEN).fract() - 1.0);
+        let k = Vec2::new((wind + turn).sin(), (wind + turn).cos());
+        let cos_a = k.dot(along);
+        let sin_a = k.perp_dot(along);
+        let footprint = ((along_m * cos_a).powi(2) + (across_m * sin_a).powi(2)).sqrt();
+        let w = 1.0 - smoothstep(WAVE_FADE_START, WAVE_FADE_END, footprint / wavelength);
+        if w <= 0.0 {
+            continue;
+        }
+        let phase =
+            2.0 * PI * ((x * k.x + z * k.y) / wavelength + ((fi + 1.0) * GOLDEN * GOLDEN).fract());
+        slope += k * (w * amplitude * phase.cos());
+        resolved += w * w * share;
+    }
+    Vec3::new(slope.x, slope.y, (total - resolved).max(1e-4))
+}
+
+/// The waves ([`sea_waves`]) where a ray of cone angle `spread` from
+/// `origin` along `dir` meets the sea (y = 0) in `fr`; [`flat_sea`] where
+/// it looks up, the camera is under the sea or the sea lies beyond
+/// `max_distance_m`; `None` over land.
+pub fn sea_waves_at(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Option<Vec3> {
+    let q = &fr.quality;
+    let wind = q.sea_wind_mps?;
+    if dir.y >= 0.0 || origin.y <= 0.0 {
+        return Some(flat_sea(wind));
+    }
+    let t = origin.y / -dir.y;
+    if t > q.max_distance_m {
+        return Some(flat_sea(wind));
+    }
+    Some(sea_waves(
+        origin.x + dir.x * t,
+        origin.z + dir.z * t,
+        dir,
+        spread,
+        t,
+        wind,
+        q.sea_wind_toward_deg,
+    ))
+}
+
+/// The sea's normal under the resolved `waves` ([`sea_waves`]).
+#[inline]
+pub fn wave_normal(waves: Vec3) -> Vec3 {
+    Vec3::new(-waves.x, 1.0, -waves.y).normalize()
+}
+
+/// The flat, rough sea: no resolved slope, all of Cox and Munk's variance
+/// in a wind of `wind_mps` ([`slope_variance`]).
+#[inline]
+pub fn flat_sea(wind_mps: f32) -> Vec3 {
+    Vec3::new(0.0, 0.0, slope_variance(wind_mps))
+}
+
+#[inline]
+fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_waves_keep_cox_and_munks_variance() {
+        let wind = 7.0;
+        let total = slope_variance(wind);
+        let dir = Vec3::new(0.3, -0.4, 0.8).normalize();
+        // Far away no train is resolved: the flat sea, all the variance
+        // in the glint's roughness.
+        let far = sea_waves(123.0, -45.0, dir, 1e-3, 2e5, wind, 90.0);
+        assert_eq!(far, flat_sea(wind));
+        // A tiny pixel resolves them all: their slopes' variance over the
+        // sea is the trains' share, the rest stays unresolved.
+        let n = 40_000;
+        let (mut sum, mut sum2, mut unresolved) = (Vec2::ZERO, 0.0, 0.0);
+        for i in 0..n {
+            let (x, z) = (
+                (i % 200) as f32 * 3.7 + 0.13 * i as f32,
+                (i / 200) as f32 * 4.1,
+            );
+            let w = sea_waves(x, z, dir, 1e-7, 10.0, wind, 90.0);
+            sum += Vec2::new(w.x, w.y);
+            sum2 += w.x * w.x + w.y * w.y;
+            unresolved = w.z;
+        }
+        let mean = sum / n as f32;
+        let variance = sum2 / n as f32 - mean.length_squared();
+        let trains = wave_variance(wind);
+        assert!(mean.length() < 0.02, "mean slope {mean}");
+        assert!(
+            (variance / trains - 1.0).abs() < 0.1,
+            "{variance} vs {trains}"
+        );
+        assert!((unresolved - (total - trains)).abs() < 1e-5);
+        // The trains carry about half of it at 7 m/s, and never all.
+        assert!((0.4..0.6).contains(&(trains / total)));
+        for u in [0.0, 1.0, 3.0, 15.0, 30.0] {
+            assert!(wave_variance(u) <= WAVE_SHARE_MAX * slope_variance(u) + 1e-7);
+        }
+    }
+
+    #[test]
+    fn the_waves_run_along_the_wind() {
+        // Slopes along the wind outweigh those across it.
+        let dir = Vec3::new(0.0, -1.0, 0.0);
+        let (mut along, mut across) = (0.0, 0.0);
+        for i in 0..10_000 {
+            let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
+            // Toward the east (+x).
+            let w = sea_waves(x, z, dir, 1e-7, 10.0, 7.0, 90.0);
+            along += w.x * w.x;
+            across += w.y * w.y;
+        }
+        assert!(along > 1.5 * across, "{along} vs {across}");
+    }
+
+    #[test]
+    fn a_grazing_pixel_resolves_fewer_waves_along_the_line_of_sight() {
+        // Seen 3° down, a pixel 2 mrad wide 1 km out is 2 m across and
+        // 38 m along the line of sight: the trains that run along it fade
+        // first, so the resolved slope's variance across it is larger.
+        let dir = Vec3::new(0.0, -(3f32.to_radians().sin()), 3f32.to_radians().cos());
+        let (mut x_var, mut z_var) = (0.0, 0.0);
+        for i in 0..10_000 {
+            let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
+            // Wind toward the north-east: trains both along and across.
+            let w = sea_waves(x, z, dir, 2e-3, 1000.0, 7.0, 45.0);
+            x_var += w.x * w.x;
+            z_var += w.y * w.y;
+        }
+        assert!(x_var > 2.0 * z_var, "{x_var} vs {z_var}");
+        let w = sea_waves(0.0, 0.0, dir, 2e-3, 1000.0, 7.0, 45.0);
+        assert!(w.z > 0.5 * slope_variance(7.0) && w.z < slope_variance(7.0));
+    }
+}
