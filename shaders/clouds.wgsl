@@ -115,6 +115,8 @@ const WAVE_FADE_END: f32 = 0.5;
 // The most a pixel's footprint on the sea is longer along the line of
 // sight than across it, for the waves.
 const WAVE_ANISOTROPY_MAX: f32 = 4.0;
+// Gravity at the sea's surface, m/s^2 (the CPU's waves.rs).
+const GRAVITY: f32 = 9.81;
 // The golden ratio's fraction (the CPU's sampling::GOLDEN).
 const GOLDEN: f32 = 0.618034;
 // The clip depth at which rays are unprojected.
@@ -132,7 +134,7 @@ struct Frame {
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
-    terrain: vec4f,      // extent (m), highest point (m), unused, unused
+    terrain: vec4f,      // extent (m), highest point (m), the sea's clock (s), unused
     counts: vec4u,       // steps, P width, P height, frame index
     mask: vec4u,         // mask width, height, P texels per mask cell, unused
     view_proj: mat4x4f,
@@ -606,6 +608,12 @@ fn water_light(sun: vec3f, sun_dir: vec3f) -> vec3f {
         * (sun * (max(sun_dir.y, 0.0) / PI) + sky_ambient(sun_dir));
 }
 
+// A deep-water wave's frequency, Hz: sqrt(g / (2 pi wavelength)) (the
+// CPU's `wave_frequency`).
+fn wave_frequency(wavelength: f32) -> f32 {
+    return sqrt(GRAVITY / (2.0 * PI * wavelength));
+}
+
 // Cox and Munk's mean square slope of a clean sea (the CPU's
 // `slope_variance`).
 fn slope_variance(wind_mps: f32) -> f32 {
@@ -622,7 +630,7 @@ fn wave_variance(wind_mps: f32) -> f32 {
 // The wave slope a pixel resolves at (x, z) and the slope variance it
 // does not: WAVE_COUNT trains over WAVE_OCTAVES of wavelength, each faded by the
 // pixel's footprint along it (the CPU's `sea_waves`).
-fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, toward_deg: f32) -> vec3f {
+fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, toward_deg: f32, time_s: f32) -> vec3f {
     let total = slope_variance(wind_mps);
     let share = wave_variance(wind_mps) / f32(WAVE_COUNT);
     let amplitude = sqrt(2.0 * share);
@@ -647,7 +655,8 @@ fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, tow
         if w <= 0.0 {
             continue;
         }
-        let phase = 2.0 * PI * ((x * k.x + z * k.y) / wavelength + fract((fi + 1.0) * GOLDEN * GOLDEN));
+        let travelled = fract(time_s * wave_frequency(wavelength));
+        let phase = 2.0 * PI * ((x * k.x + z * k.y) / wavelength + fract((fi + 1.0) * GOLDEN * GOLDEN) - travelled);
         slope += k * (w * amplitude * cos(phase));
         resolved += w * w * share;
     }
@@ -665,7 +674,7 @@ fn sea_waves_at(origin: vec3f, dir: vec3f) -> vec3f {
     if t > frame.sun_light.w {
         return flat_sea(SEA_WIND_MPS);
     }
-    return sea_waves(origin.x + dir.x * t, origin.z + dir.z * t, dir, frame.cam_pos.w, t, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG);
+    return sea_waves(origin.x + dir.x * t, origin.z + dir.z * t, dir, frame.cam_pos.w, t, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG, frame.terrain.z);
 }
 
 // No resolved slope, all of Cox and Munk's variance (the CPU's
@@ -789,7 +798,7 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
     let p = vec3f(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
     // The resolved waves' mirror ray; the slopes the pixel does not
     // resolve spread the reflected rays about it.
-    let waves = sea_waves(p.x, p.z, dir, frame.cam_pos.w, t_sea, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG);
+    let waves = sea_waves(p.x, p.z, dir, frame.cam_pos.w, t_sea, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG, frame.terrain.z);
     let r0 = sea_mirror(dir, waves);
     let across = normalize_or(vec3f(r0.x, 0.0, r0.z), vec3f(0.0, 0.0, 1.0));
     let mirror = asin(clamp(r0.y, -1.0, 1.0));

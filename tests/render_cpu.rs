@@ -392,6 +392,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
             exposure: 1.0,
             sea_wind_mps: None,
             sea_wind_toward_deg: 90.0,
+            sea_time_s: 0.0,
             land_fields: false,
             atmosphere: AtmosphereConfig {
                 model: SkyModel::Analytic,
@@ -460,6 +461,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
             exposure: 1.2,
             sea_wind_mps: None,
             sea_wind_toward_deg: 90.0,
+            sea_time_s: 0.0,
             land_fields: false,
             atmosphere: AtmosphereConfig {
                 model: SkyModel::Analytic,

@@ -191,6 +191,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("GOLDEN", cumulus::render::sampling::GOLDEN as f64),
         ("WAVE_COUNT", waves::WAVE_COUNT as f64),
         ("WAVE_OCTAVES", waves::WAVE_OCTAVES as f64),
+        ("GRAVITY", waves::GRAVITY as f64),
         ("WAVE_ANISOTROPY_MAX", waves::WAVE_ANISOTROPY_MAX as f64),
         ("SKY_MIRROR_RAYS", sky::SKY_MIRROR_RAYS as f64),
         ("WAVE_LONGEST_M", waves::WAVE_LONGEST_M as f64),

@@ -71,6 +71,9 @@ struct App {
     scenes: Vec<PathBuf>,
     save_path: String,
     last_frame: Instant,
+    /// The sea's clock, s: the viewer's time since the start (the waves
+    /// move at their own pace whatever the physics' speed or pause).
+    sea_clock_s: f64,
     frames_done: u32,
     dragging: bool,
     cursor: Option<(f64, f64)>,
@@ -99,6 +102,7 @@ impl App {
             timings: ui::Timings::default(),
             message: None,
             last_frame: Instant::now(),
+            sea_clock_s: 0.0,
             frames_done: 0,
             dragging: false,
             cursor: None,
@@ -170,6 +174,7 @@ impl App {
             wall_dt.min(0.25)
         };
         self.timings.frame_ms = wall_dt * 1e3;
+        self.sea_clock_s += dt;
         self.world.update(dt);
         self.camera.update(dt as f32);
         self.timings.physics_ms = self.world.physics_ms;
@@ -265,6 +270,7 @@ impl App {
             });
         g.clouds
             .set_timestamp_queries(g.timestamps.as_ref().map(|t| t.0.clone()));
+        g.clouds.set_sea_time(self.sea_clock_s as f32);
         g.clouds
             .render(&mut encoder, &view, None, &self.camera.camera)?;
         let read_timestamps = g.timestamps.is_some() && self.frames_done.is_multiple_of(30);

@@ -419,6 +419,7 @@ impl RenderSettings {
             exposure: self.exposure,
             sea_wind_mps: self.ground.sea_wind_mps(),
             sea_wind_toward_deg: self.ground.wind_direction_deg,
+            sea_time_s: self.time_s as f32,
             land_fields: self.ground.land_fields(),
             atmosphere: self.atmosphere,
             single_scattering: false,

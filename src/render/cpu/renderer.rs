@@ -50,6 +50,11 @@ pub struct Quality {
     /// The direction the sea's wind blows toward, degrees clockwise from
     /// north: the waves run along it ([`super::waves::sea_waves`]).
     pub sea_wind_toward_deg: f32,
+    /// The sea's clock, s: where its waves are in their travel
+    /// ([`super::waves::sea_waves`]). The CLI's stills take
+    /// `render.time_s`; the GPU renderer's
+    /// [`crate::render::gpu::CloudRenderer::set_sea_time`] moves it per frame.
+    pub sea_time_s: f32,
     /// The land drawn as fields and woods
     /// ([`super::land::land_albedo`]); off: one colour,
     /// [`super::sky::LAND_ALBEDO`]. Off under the sea.

@@ -5,8 +5,8 @@
 //! Cox and Munk's (1954) slope variance. Twins of the WGSL functions of
 //! the same names in `shaders/clouds.wgsl`.
 //!
-//! The waves are fixed in space (no time): they stand still under a
-//! camera that moves, and the demo's sea does not ripple.
+//! Each train travels along its direction at deep water's phase speed,
+//! on the sea's clock (`Quality::sea_time_s`).
 
 use std::f32::consts::PI;
 
@@ -53,6 +53,17 @@ pub const WAVE_FADE_END: f32 = 0.5;
 /// blur. The waves across the line of sight fade sooner instead.
 pub const WAVE_ANISOTROPY_MAX: f32 = 4.0;
 
+/// Gravity at the sea's surface, m/s² (`GRAVITY` in WGSL).
+pub const GRAVITY: f32 = 9.81;
+
+/// The frequency of a deep-water wave of `wavelength` m, Hz: its
+/// dispersion `ω² = g k`, so `f = √(g / (2π λ))` (a 60 m wave has a
+/// period of 6.2 s, a 1 m wave of 0.8 s).
+#[inline]
+pub fn wave_frequency(wavelength: f32) -> f32 {
+    (GRAVITY / (2.0 * PI * wavelength)).sqrt()
+}
+
 /// Cox and Munk's (1954) mean square slope of a clean sea in a wind of
 /// `wind_mps` (both directions together): `0.003 + 0.00512 U`.
 #[inline]
@@ -75,11 +86,12 @@ pub fn wave_variance(wind_mps: f32) -> f32 {
 /// sea and the slope variance it does not (the glint's roughness), as
 /// `(slope x, slope z, variance)`, for a wind of `wind_mps` blowing
 /// toward `toward_deg` (clockwise from north, +z), seen along `dir` (down)
-/// by a pixel of cone angle `spread` at distance `t`.
+/// by a pixel of cone angle `spread` at distance `t`, at `time_s` on the
+/// sea's clock.
 ///
 /// Train `i` has wavelength `WAVE_LONGEST_M · 2^{-WAVE_OCTAVES · i / WAVE_COUNT}`, a direction
 /// spread about the wind's by the golden-ratio sequence and a phase the
-/// same, and an equal share of [`wave_variance`] (a saturated sea's
+/// same, travelling along it at its [`wave_frequency`], and an equal share of [`wave_variance`] (a saturated sea's
 /// slopes spread evenly over the wavenumbers' octaves). Its weight in the
 /// pixel fades with the pixel's footprint along it (its width across the
 /// line of sight, `spread · t` but at least [`WAVE_ANISOTROPY_MAX`]-th of
@@ -87,6 +99,7 @@ pub fn wave_variance(wind_mps: f32) -> f32 {
 /// variance it loses, and all of [`slope_variance`] that the trains do not
 /// carry, is the unresolved variance. Far away that is the whole of
 /// [`slope_variance`] and the slope 0: the flat, rough sea.
+#[allow(clippy::too_many_arguments)]
 pub fn sea_waves(
     x: f32,
     z: f32,
@@ -95,6 +108,7 @@ pub fn sea_waves(
     t: f32,
     wind_mps: f32,
     toward_deg: f32,
+    time_s: f32,
 ) -> Vec3 {
     let total = slope_variance(wind_mps);
     let share = wave_variance(wind_mps) / WAVE_COUNT as f32;
@@ -117,8 +131,11 @@ pub fn sea_waves(
         if w <= 0.0 {
             continue;
         }
-        let phase =
-            2.0 * PI * ((x * k.x + z * k.y) / wavelength + ((fi + 1.0) * GOLDEN * GOLDEN).fract());
+        let travelled = (time_s * wave_frequency(wavelength)).fract();
+        let phase = 2.0
+            * PI
+            * ((x * k.x + z * k.y) / wavelength + ((fi + 1.0) * GOLDEN * GOLDEN).fract()
+                - travelled);
         slope += k * (w * amplitude * phase.cos());
         resolved += w * w * share;
     }
@@ -147,6 +164,7 @@ pub fn sea_waves_at(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Option<
         t,
         wind,
         q.sea_wind_toward_deg,
+        q.sea_time_s,
     ))
 }
 
@@ -180,7 +198,7 @@ mod tests {
         let dir = Vec3::new(0.3, -0.4, 0.8).normalize();
         // Far away no train is resolved: the flat sea, all the variance
         // in the glint's roughness.
-        let far = sea_waves(123.0, -45.0, dir, 1e-3, 2e5, wind, 90.0);
+        let far = sea_waves(123.0, -45.0, dir, 1e-3, 2e5, wind, 90.0, 0.0);
         assert_eq!(far, flat_sea(wind));
         // A tiny pixel resolves them all: their slopes' variance over the
         // sea is the trains' share, the rest stays unresolved.
@@ -191,7 +209,7 @@ mod tests {
                 (i % 200) as f32 * 3.7 + 0.13 * i as f32,
                 (i / 200) as f32 * 4.1,
             );
-            let w = sea_waves(x, z, dir, 1e-7, 10.0, wind, 90.0);
+            let w = sea_waves(x, z, dir, 1e-7, 10.0, wind, 90.0, 0.0);
             sum += Vec2::new(w.x, w.y);
             sum2 += w.x * w.x + w.y * w.y;
             unresolved = w.z;
@@ -213,6 +231,37 @@ mod tests {
     }
 
     #[test]
+    fn each_train_travels_at_deep_waters_phase_speed() {
+        // Deep water's dispersion: a 60 m wave's period is √(2πλ/g),
+        // 6.20 s; its phase speed λ/T, 9.68 m/s.
+        assert!((1.0 / wave_frequency(60.0) - 6.20).abs() < 0.01);
+        assert!((60.0 * wave_frequency(60.0) - 9.68).abs() < 0.01);
+        // One train alone (a pixel that resolves only the longest, whose
+        // footprint is past WAVE_FADE_END of every other's wavelength):
+        // its slope at (x, t) returns a phase speed times dt further along
+        // its direction at t + dt.
+        let dir = Vec3::new(0.0, -1.0, 0.0);
+        let second = WAVE_LONGEST_M * (-WAVE_OCTAVES / WAVE_COUNT as f32).exp2();
+        let footprint = 0.5 * WAVE_FADE_END * (second + WAVE_LONGEST_M);
+        let spread = footprint / 100.0;
+        let at = |x: f32, z: f32, time: f32| sea_waves(x, z, dir, spread, 100.0, 7.0, 90.0, time);
+        let turn = WAVE_SPREAD * (2.0 * GOLDEN - 1.0);
+        let heading = 90f32.to_radians() + turn;
+        let k = Vec2::new(heading.sin(), heading.cos());
+        let c = WAVE_LONGEST_M * wave_frequency(WAVE_LONGEST_M);
+        let (mut moved, mut still) = (0.0, 0.0);
+        for i in 0..50 {
+            let (x, z) = (3.1 * i as f32, -1.7 * i as f32);
+            let a = at(x, z, 0.0);
+            let b = at(x + k.x * c * 1.5, z + k.y * c * 1.5, 1.5);
+            moved += (a - b).length();
+            still += (a - at(x, z, 1.5)).length();
+        }
+        assert!(still > 1e-4, "the train moves: {still}");
+        assert!(moved < 1e-2 * still, "{moved} vs {still}");
+    }
+
+    #[test]
     fn the_waves_run_along_the_wind() {
         // Slopes along the wind outweigh those across it.
         let dir = Vec3::new(0.0, -1.0, 0.0);
@@ -220,7 +269,7 @@ mod tests {
         for i in 0..10_000 {
             let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
             // Toward the east (+x).
-            let w = sea_waves(x, z, dir, 1e-7, 10.0, 7.0, 90.0);
+            let w = sea_waves(x, z, dir, 1e-7, 10.0, 7.0, 90.0, 0.0);
             along += w.x * w.x;
             across += w.y * w.y;
         }
@@ -237,12 +286,12 @@ mod tests {
         for i in 0..10_000 {
             let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
             // Wind toward the north-east: trains both along and across.
-            let w = sea_waves(x, z, dir, 2e-3, 1000.0, 7.0, 45.0);
+            let w = sea_waves(x, z, dir, 2e-3, 1000.0, 7.0, 45.0, 0.0);
             x_var += w.x * w.x;
             z_var += w.y * w.y;
         }
         assert!(x_var > 2.0 * z_var, "{x_var} vs {z_var}");
-        let w = sea_waves(0.0, 0.0, dir, 2e-3, 1000.0, 7.0, 45.0);
+        let w = sea_waves(0.0, 0.0, dir, 2e-3, 1000.0, 7.0, 45.0, 0.0);
         assert!(w.z > 0.5 * slope_variance(7.0) && w.z < slope_variance(7.0));
     }
 }

@@ -359,6 +359,13 @@ impl CloudRenderer {
         self.frame_index = n;
     }
 
+    /// Sets the sea's clock, s (`Quality::sea_time_s`): where its waves
+    /// are in their travel. Call it every frame with the time that
+    /// passes for the viewer; nothing is rebuilt.
+    pub fn set_sea_time(&mut self, seconds: f32) {
+        self.settings.quality.sea_time_s = seconds;
+    }
+
     /// Frames in the TSAA history since the last reset (0 without TSAA).
     pub fn history_frames(&self) -> u32 {
         self.tsaa.as_ref().map_or(0, |t| t.frames)

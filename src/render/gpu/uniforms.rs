@@ -112,7 +112,7 @@ impl FrameUniforms {
                 d.map_extent_m / i.map_size.max(1) as f32,
             ],
             jitter: [i.jitter[0], i.jitter[1], i.jitter[2], i.blend],
-            terrain: [i.terrain[0], i.terrain[1], 0.0, 0.0],
+            terrain: [i.terrain[0], i.terrain[1], q.sea_time_s, 0.0],
             counts: [q.steps.max(1), i.p_size[0], i.p_size[1], i.frame_index],
             mask: i.mask,
             view_proj: i.view.view_projection().to_cols_array_2d(),
