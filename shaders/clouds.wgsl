@@ -608,6 +608,12 @@ fn water_light(sun: vec3f, sun_dir: vec3f) -> vec3f {
         * (sun * (max(sun_dir.y, 0.0) / PI) + sky_ambient(sun_dir));
 }
 
+// A pixel's length on the sea along the line of sight (the CPU's
+// `wave_footprint`).
+fn wave_footprint(spread: f32, t: f32, sin_down: f32) -> f32 {
+    return spread * t / max(abs(sin_down), 1e-3);
+}
+
 // A deep-water wave's frequency, Hz: sqrt(g / (2 pi wavelength)) (the
 // CPU's `wave_frequency`).
 fn wave_frequency(wavelength: f32) -> f32 {
@@ -638,7 +644,7 @@ fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, tow
     if dot(dir.xz, dir.xz) > 0.0 {
         along = normalize(dir.xz);
     }
-    let along_m = ground_footprint(spread, t, dir.y);
+    let along_m = wave_footprint(spread, t, dir.y);
     let across_m = max(spread * t, along_m / WAVE_ANISOTROPY_MAX);
     let wind = radians(toward_deg);
     var slope = vec2f(0.0);
@@ -656,7 +662,9 @@ fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, tow
             continue;
         }
         let travelled = fract(time_s * wave_frequency(wavelength));
-        let phase = 2.0 * PI * ((x * k.x + z * k.y) / wavelength + fract((fi + 1.0) * GOLDEN * GOLDEN) - travelled);
+        // In cycles, reduced to one before the cosine (a GPU's cosine of
+        // thousands of radians is not its twin's).
+        let phase = 2.0 * PI * fract((x * k.x + z * k.y) / wavelength + fract((fi + 1.0) * GOLDEN * GOLDEN) - travelled);
         slope += k * (w * amplitude * cos(phase));
         resolved += w * w * share;
     }
@@ -715,7 +723,7 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f, waves: vec3f, shadow: f32, reflectio
     let h = normalize_or(sun_dir - dir, vec3f(0.0, 1.0, 0.0));
     let cos_b = max(h.y, 1e-3);
     let tan2 = (h.x / cos_b + waves.x) * (h.x / cos_b + waves.x) + (h.z / cos_b + waves.y) * (h.z / cos_b + waves.y);
-    let cos2 = 1.0 / (1.0 + tan2);
+    let cos2 = cos_b * cos_b;
     let d = exp(-tan2 / variance) / (PI * variance * cos2 * cos2);
     var glint = vec3f(0.0);
     if sun_dir.y > 0.0 {
@@ -726,9 +734,10 @@ fn sea_radiance(dir: vec3f, sun_dir: vec3f, waves: vec3f, shadow: f32, reflectio
 }
 
 // The elevation (radians) of a ray the wind-roughened sea reflects where
-// the flat sea's mirror ray rises at `mirror`, at the quantile `u` of the
-// waves' slopes: a logistic of Cox and Munk's deviation, cut off below
-// REFLECTION_MIN_ELEVATION (the CPU's `reflected_elevation`).
+// the resolved waves' mirror ray rises at `mirror`, at the quantile `u` of
+// the unresolved slopes (mean square `variance`): a logistic of their
+// deviation, cut off below REFLECTION_MIN_ELEVATION (the CPU's
+// `reflected_elevation`).
 fn reflected_elevation(mirror: f32, variance: f32, u: f32) -> f32 {
     let deviation = sqrt(2.0 * max(variance, 0.0));
     let s = deviation * sqrt(3.0) / PI;
@@ -738,7 +747,8 @@ fn reflected_elevation(mirror: f32, variance: f32, u: f32) -> f32 {
 }
 
 // A wave's slope across the line of sight at the quantile `u`: a logistic
-// of Cox and Munk's deviation in one direction (the CPU's `cross_slope`).
+// of the unresolved slopes' deviation in one direction (the CPU's
+// `cross_slope`).
 fn cross_slope(variance: f32, u: f32) -> f32 {
     let deviation = sqrt(0.5 * max(variance, 0.0));
     let s = deviation * sqrt(3.0) / PI;
@@ -772,14 +782,15 @@ fn mirrored_sky(dir: vec3f, waves: vec3f, sun_dir: vec3f) -> vec3f {
 }
 
 // What the clouds the sea mirrors change in a sea pixel's radiance: the sea
-// with them less without them (the CPU's `sea_reflection_change`). The
-// cloud pass adds it to the cloud layer, so TSAA accumulates it.
+// with them less without them, under the flat sea's mirror and Fresnel
+// factor (the CPU's `sea_reflection_change`). The cloud pass adds it to
+// the cloud layer, so TSAA accumulates it.
 fn sea_reflection_change(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec3f {
     let r = sea_reflection(origin, dir, dither, sun_dir);
     if r.a >= 1.0 && all(r.rgb == vec3f(0.0)) {
         return vec3f(0.0);
     }
-    let waves = sea_waves_at(origin, dir);
+    let waves = flat_sea(SEA_WIND_MPS);
     return (r.rgb - mirrored_sky(dir, waves, sun_dir) * (1.0 - r.a)) * sea_fresnel(dir, waves) * ground_haze_transmittance(dir, sun_dir);
 }
 

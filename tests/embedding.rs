@@ -13,7 +13,7 @@ use cumulus::render::cpu::land::flat_ground_albedo;
 use cumulus::render::cpu::renderer::{
     flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
 };
-use cumulus::render::cpu::sea::sea_reflection;
+use cumulus::render::cpu::sea::sea_reflection_change;
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};
 use cumulus::render::cpu::waves::sea_waves_at;
 use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
@@ -322,7 +322,8 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
             let shadow = flat_ground_shadow(view.eye(), dir, sun, &frame);
             let spread = view.pixel_spread(W, H);
             let dither = pixel_dither(x as u32, y as u32);
-            let reflection = sea_reflection(view.eye(), dir, dither, sun, spread, &frame);
+            // The sea as march_ray draws it: bare, plus what the mirrored
+            // clouds change in it.
             let sky = background_radiance(
                 &frame.sky_light(),
                 dir,
@@ -330,8 +331,8 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
                 sea_waves_at(view.eye(), dir, spread, &frame),
                 shadow,
                 flat_ground_albedo(view.eye(), dir, spread, &frame),
-                reflection,
-            );
+                (Vec3::ZERO, 1.0),
+            ) + sea_reflection_change(view.eye(), dir, dither, sun, spread, &frame);
             Vec3::new(px[0], px[1], px[2]) + (1.0 - px[3]) * sky
         })
         .collect();
@@ -363,7 +364,12 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
     // clouds' edges (measured on lavapipe, 2026-12-04: 48-53 channels,
     // all below the horizon, of either sign (25 brighter on the CPU, 28
     // on the GPU), at most 10 levels; the mean difference 0.02 levels).
-    let share = if name == "bomex" { 0.004 } else { 0.002 };
+    // Since the sea's resolved waves (2026-12-05) tilt each pixel's
+    // reflected rays, more of them graze those edges: 97-98 channels, at
+    // most 10 levels (the waves themselves agree: BOMEX with no clouds,
+    // 96x64, differs by at most 1 level; with clouds, the sea's rows
+    // differ by 0.18 levels on average, 0.15 before the waves).
+    let share = if name == "bomex" { 0.0065 } else { 0.002 };
     assert!(
         off as f64 <= share * ours.len() as f64,
         "{off} channels differ by more than 2 levels"

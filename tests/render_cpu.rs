@@ -20,7 +20,7 @@ use cumulus::render::cpu::sea::{
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, LAND_ALBEDO, SkyModel, background_radiance, sun_direction, sun_light_at,
 };
-use cumulus::render::cpu::waves::{sea_waves_at, slope_variance};
+use cumulus::render::cpu::waves::{flat_sea, sea_waves_at, slope_variance};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
 
@@ -634,7 +634,12 @@ fn the_sea_mirrors_the_clouds_above_it() {
         let a = k as f32 * 10f32.to_radians();
         let e = (20.0 + 40.0 * (k % 4) as f32 / 3.0).to_radians();
         let dir = Vec3::new(e.cos() * a.sin(), -e.sin(), e.cos() * a.cos());
-        let (light, t) = sea_reflection(origin, dir, 0.5, sun, 1e-3, &sea(&cloudy));
+        // Pixels so wide (0.3 rad) that no wave is resolved: the sea
+        // with the reflection is then exactly the bare sea plus the
+        // reflection's change (sea_reflection_change takes the flat
+        // sea's mirror and Fresnel factor).
+        let spread = 0.3;
+        let (light, t) = sea_reflection(origin, dir, 0.5, sun, spread, &sea(&cloudy));
         assert!((0.0..=1.0).contains(&t) && light.is_finite());
         if t < 0.5 {
             assert!(light.max_element() > 0.0, "a cloud mirrored without light");
@@ -645,8 +650,9 @@ fn the_sea_mirrors_the_clouds_above_it() {
         let fr = sea(&cloudy);
         let sky = fr.sky_light();
         let shadow = flat_ground_shadow(origin, dir, sun, &fr);
-        let pixel = march_ray(origin, dir, 0.5, 1e-3, &fr).radiance;
-        let waves = sea_waves_at(origin, dir, 1e-3, &fr);
+        let pixel = march_ray(origin, dir, 0.5, spread, &fr).radiance;
+        let waves = sea_waves_at(origin, dir, spread, &fr);
+        assert_eq!(waves, Some(flat_sea(7.0)));
         let mirrored = background_radiance(&sky, dir, sun, waves, shadow, LAND_ALBEDO, (light, t));
         let bare = background_radiance(
             &sky,
@@ -682,10 +688,11 @@ fn the_sea_mirrors_the_clouds_above_it() {
 
 /// The sea shows its waves where a pixel resolves them: seen from 30 m,
 /// 15° down, neighbouring pixels differ by several per cent (the resolved
-/// waves tilt the mirror and the Fresnel factor); 1° down, 1.7 km out,
-/// no wave is resolved and the sea is smooth. Until 2026-12-05 the sea
-/// was a function of the ray's direction alone, a smooth gradient near
-/// and far.
+/// waves tilt the mirror and the Fresnel factor); 0.5° down, 3.4 km out,
+/// no wave is resolved (the footprint is 99 m across, by the cap on its anisotropy, and 394 m
+/// along)
+/// and the sea is smooth. Until 2026-12-05 the sea was a function of
+/// the ray's direction alone, a smooth gradient near and far.
 #[test]
 fn the_sea_shows_its_waves_near_the_camera_and_not_far_off() {
     let cm = cloud_map();
@@ -710,7 +717,13 @@ fn the_sea_shows_its_waves_near_the_camera_and_not_far_off() {
         assert!(sun.y > 0.0 && mean > 0.0);
         step / mean
     };
-    let (near, far) = (row(15.0), row(1.0));
+    let e = 0.5f32.to_radians();
+    let far_dir = Vec3::new(0.0, -e.sin(), -e.cos());
+    assert_eq!(
+        sea_waves_at(origin, far_dir, 1e-3, &fr),
+        Some(flat_sea(7.0))
+    );
+    let (near, far) = (row(15.0), row(0.5));
     assert!(near > 0.02, "near: neighbours differ by {near}");
     assert!(far < 0.002, "far: neighbours differ by {far}");
 }

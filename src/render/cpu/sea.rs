@@ -21,7 +21,7 @@ use super::sky::{
     ground_haze_transmittance, ground_up, mirrored_sky, sea_fresnel, sea_mirror, sky_ambient,
     sun_light_at,
 };
-use super::waves::{sea_waves, sea_waves_at};
+use super::waves::{flat_sea, sea_waves};
 use crate::render::sampling::GOLDEN;
 
 /// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
@@ -102,8 +102,9 @@ pub fn cross_slope(variance: f32, u: f32) -> f32 {
     s * (q / (1.0 - q)).ln()
 }
 
-/// The ray a wave sends up from the sea, seen along a ray that falls at
-/// `mirror` radians, horizontally along `across` (unit): rising at
+/// The ray a wave sends up from the sea, about a mirror ray that rises at
+/// `mirror` radians, horizontally along `across` (unit; the resolved
+/// waves' mirror ray, [`super::sky::sea_mirror`]): rising at
 /// elevation `e` ([`reflected_elevation`]) and turned sideways by the
 /// wave's slope `slope` across the line of sight ([`cross_slope`]). A
 /// facet tilted sideways by `s` adds `s (sin(mirror) + sin(e))` of the
@@ -224,10 +225,17 @@ impl ReflectionLight {
 /// radiance of a sea pixel along `dir`: [`super::sky::sea_radiance`] with them less
 /// without them, `(L - S (1 - T)) · F · T_air` for the clouds' light `L`
 /// and transmittance `T`, the mirrored sky `S` ([`mirrored_sky`]), the
-/// Fresnel factor `F` ([`sea_fresnel`]; both under the waves the pixel
-/// resolves, [`sea_waves_at`]) and the air's transmittance `T_air`
-/// ([`ground_haze_transmittance`]); zero where nothing is mirrored. The
-/// sky `S` the clouds hide is the resolved waves' mirror's, though the reflected
+/// Fresnel factor `F` ([`sea_fresnel`]; both of the flat, rough sea,
+/// [`flat_sea`], not of the waves the pixel resolves) and the air's
+/// transmittance `T_air` ([`ground_haze_transmittance`]); zero where
+/// nothing is mirrored. On the GPU this term is accumulated by TSAA over
+/// jittered rays and moving waves while the composite draws the sea at
+/// the pixel's centre now: with the resolved waves' `S F` in both, their
+/// history and the present would not cancel, and the sky's ripples would
+/// show under the mirrored clouds. With the flat sea's, what is left of
+/// the waves under a mirrored cloud is their ripple of the sky about its
+/// mean (and the cloud's image unrippled by the Fresnel factor), on the
+/// CPU and the GPU alike. The sky `S` the clouds hide is the flat sea's mirror's, though the reflected
 /// rays that meet them rise higher: near the horizon, where the mirrored
 /// sky is brightest, the change is somewhat too dark.
 /// The GPU adds it to the cloud layer in the cloud pass (under the
@@ -245,9 +253,10 @@ pub fn sea_reflection_change(
     if transmittance >= 1.0 && light == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let Some(waves) = sea_waves_at(origin, dir, spread, fr) else {
+    let Some(wind) = fr.quality.sea_wind_mps else {
         return Vec3::ZERO;
     };
+    let waves = flat_sea(wind);
     let sky = &fr.sky_light();
     (light - mirrored_sky(sky, dir, waves, sun_dir) * (1.0 - transmittance))
         * sea_fresnel(dir, waves)

@@ -505,9 +505,11 @@ pub fn sea_radiance(
     let variance = waves.z;
     let h = (sun_dir - dir).normalize_or(Vec3::Y);
     let cos_b = h.y.max(1e-3);
-    // The half vector's facet slope less the resolved slope.
+    // The half vector's facet slope less the resolved slope, in the
+    // exponent; the slope space's Jacobian, 1 / cos⁴, is the half
+    // vector's own (to the vertical).
     let tan2 = (h.x / cos_b + waves.x).powi(2) + (h.z / cos_b + waves.y).powi(2);
-    let cos2 = 1.0 / (1.0 + tan2);
+    let cos2 = cos_b * cos_b;
     let d = (-tan2 / variance).exp() / (PI * variance * cos2 * cos2);
     let glint = if sun_dir.y > 0.0 {
         sun * (fresnel_water(h.dot(sun_dir)) * d / (4.0 * mu))

@@ -361,7 +361,8 @@ impl CloudRenderer {
 
     /// Sets the sea's clock, s (`Quality::sea_time_s`): where its waves
     /// are in their travel. Call it every frame with the time that
-    /// passes for the viewer; nothing is rebuilt.
+    /// passes for the viewer (after [`Self::set_settings`], whose
+    /// settings carry their own `sea_time_s`); nothing is rebuilt.
     pub fn set_sea_time(&mut self, seconds: f32) {
         self.settings.quality.sea_time_s = seconds;
     }
