@@ -61,6 +61,9 @@ from PIL import Image
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
+# The side-by-sides draw each pixel as a block of this many pixels a side.
+FIGURE_SCALE = 4
+
 # Our sun disk's angular radius (sky_luts::atmosphere, the physical sky).
 SUN_RADIUS_DEG = 0.2678
 
@@ -429,6 +432,9 @@ def main():
             err_img = np.stack([err * 255, (1 - err) * 255 * cloud, np.zeros_like(err)], axis=2)
             err_img = np.where(cloud[..., None], err_img, 0).astype(np.uint8)
             strip = np.concatenate([aces(ours, exposure), aces(truth, exposure), err_img], axis=1)
+            # Each pixel drawn as a 4x4 block: at 80x60 the panels were too
+            # small to read on a page.
+            strip = np.repeat(np.repeat(strip, FIGURE_SCALE, axis=0), FIGURE_SCALE, axis=1)
             Image.fromarray(strip).save(os.path.join(a.out, f"{name}_side_by_side.png"))
             print(f"{name}: {n} cloud pixels, mean |rel. error| {mean_rel:.3f} "
                   f"(4x4 blocks {mean_rel_b:.3f}), bias {bias:+.3f}, "
