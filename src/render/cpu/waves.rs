@@ -99,16 +99,18 @@ pub fn wave_variance(wind_mps: f32) -> f32 {
 /// by a pixel of cone angle `spread` at distance `t`, at `time_s` on the
 /// sea's clock.
 ///
-/// Train `i` has wavelength `WAVE_LONGEST_M · 2^{-WAVE_OCTAVES · i / WAVE_COUNT}`, a direction
-/// spread about the wind's by the golden-ratio sequence and a phase the
-/// same, travelling along it at its [`wave_frequency`], and an equal share of [`wave_variance`] (a saturated sea's
-/// slopes spread evenly over the wavenumbers' octaves). Its weight in the
-/// pixel fades with the pixel's footprint along it (its width across the
-/// line of sight, `spread · t` but at least [`WAVE_ANISOTROPY_MAX`]-th of
-/// its length, and along it, [`wave_footprint`]); the
-/// variance it loses, and all of [`slope_variance`] that the trains do not
-/// carry, is the unresolved variance. Far away that is the whole of
-/// [`slope_variance`] and the slope 0: the flat, rough sea.
+/// Train `i` has wavelength `WAVE_LONGEST_M · 2^{-WAVE_OCTAVES · i /
+/// WAVE_COUNT}`, a direction spread about the wind's by the golden-ratio
+/// sequence and a phase the same, travels along that direction at its
+/// [`wave_frequency`], and carries an equal share of [`wave_variance`] (a
+/// saturated sea's slopes spread evenly over the wavenumbers' octaves).
+/// Its weight in the pixel fades with the pixel's footprint along it (its
+/// width across the line of sight, `spread · t` but at least
+/// [`WAVE_ANISOTROPY_MAX`]-th of its length, and along it,
+/// [`wave_footprint`]); the variance it loses, and all of
+/// [`slope_variance`] that the trains do not carry, is the unresolved
+/// variance. Far away that is the whole of [`slope_variance`] and the
+/// slope 0: the flat, rough sea.
 #[allow(clippy::too_many_arguments)]
 pub fn sea_waves(
     x: f32,
