@@ -370,6 +370,8 @@ pub fn bars_png(
                 SegmentValue::CenterOf(i) => bars.get(*i).map_or(String::new(), |b| b.0.clone()),
                 _ => String::new(),
             })
+            // 4000, not 4000.0.
+            .y_label_formatter(&|v| tick_label(*v))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| err(&e))?;
