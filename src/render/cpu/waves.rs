@@ -12,6 +12,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
+use super::density::smoothstep;
 use super::renderer::Frame;
 use crate::render::sampling::GOLDEN;
 
@@ -194,12 +195,6 @@ pub fn flat_sea(wind_mps: f32) -> Vec3 {
     Vec3::new(0.0, 0.0, slope_variance(wind_mps))
 }
 
-#[inline]
-fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
-    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -272,18 +267,22 @@ mod tests {
         assert!(moved < 1e-2 * still, "{moved} vs {still}");
     }
 
+    /// The sums of the squared resolved slopes along x and along z over
+    /// a grid of 10,000 points, seen along `dir` by a pixel of cone angle
+    /// `spread` at `t`, in a 7 m/s wind toward `toward_deg`.
+    fn slope_sums(dir: Vec3, spread: f32, t: f32, toward_deg: f32) -> (f32, f32) {
+        (0..10_000).fold((0.0, 0.0), |(sx, sz), i| {
+            let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
+            let w = sea_waves(x, z, dir, spread, t, 7.0, toward_deg, 0.0);
+            (sx + w.x * w.x, sz + w.y * w.y)
+        })
+    }
+
     #[test]
     fn the_waves_run_along_the_wind() {
-        // Slopes along the wind outweigh those across it.
-        let dir = Vec3::new(0.0, -1.0, 0.0);
-        let (mut along, mut across) = (0.0, 0.0);
-        for i in 0..10_000 {
-            let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
-            // Toward the east (+x).
-            let w = sea_waves(x, z, dir, 1e-7, 10.0, 7.0, 90.0, 0.0);
-            along += w.x * w.x;
-            across += w.y * w.y;
-        }
+        // Slopes along the wind (toward the east, +x) outweigh those
+        // across it.
+        let (along, across) = slope_sums(Vec3::new(0.0, -1.0, 0.0), 1e-7, 10.0, 90.0);
         assert!(along > 1.5 * across, "{along} vs {across}");
     }
 
@@ -294,14 +293,8 @@ mod tests {
         // trains that run along it fade first, so the resolved slope's
         // variance across it is larger.
         let dir = Vec3::new(0.0, -(3f32.to_radians().sin()), 3f32.to_radians().cos());
-        let (mut x_var, mut z_var) = (0.0, 0.0);
-        for i in 0..10_000 {
-            let (x, z) = ((i % 100) as f32 * 1.37, (i / 100) as f32 * 1.91);
-            // Wind toward the north-east: trains both along and across.
-            let w = sea_waves(x, z, dir, 2e-3, 1000.0, 7.0, 45.0, 0.0);
-            x_var += w.x * w.x;
-            z_var += w.y * w.y;
-        }
+        // Wind toward the north-east: trains both along and across.
+        let (x_var, z_var) = slope_sums(dir, 2e-3, 1000.0, 45.0);
         assert!(x_var > 2.0 * z_var, "{x_var} vs {z_var}");
         let w = sea_waves(0.0, 0.0, dir, 2e-3, 1000.0, 7.0, 45.0, 0.0);
         assert!(w.z > 0.5 * slope_variance(7.0) && w.z < slope_variance(7.0));
