@@ -244,7 +244,13 @@ fn spheroids_and_cloud_map_draw_the_same_parcels() {
         hl.read_rgb8(&ctx).unwrap()
     };
     let baseline = |with_spheres: bool| {
-        let mut b = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+        let mut b = SpheroidRenderer::new(
+            &ctx.device,
+            &ctx.queue,
+            TARGET_FORMAT,
+            &settings,
+            p.cloud_map.noise(),
+        );
         if with_spheres {
             b.update_spheroids(&p.spheroids());
         }
@@ -304,7 +310,13 @@ fn the_spheroid_renderer_matches_its_cpu_twin() {
     let spheroids = p.spheroids();
     assert!(spheroids.len() > 10, "{} spheroids", spheroids.len());
     let settings = p.gpu_settings(r, r.quality());
-    let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+    let mut s = SpheroidRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        TARGET_FORMAT,
+        &settings,
+        p.cloud_map.noise(),
+    );
     s.update_spheroids(&spheroids);
     let gpu = s.read_rgb8(&ctx, &r.camera(), w, h).unwrap();
     let frame = p.frame(r, r.quality());
@@ -314,7 +326,13 @@ fn the_spheroid_renderer_matches_its_cpu_twin() {
     let (mean, within) = agreement(&gpu, &cpu);
     // The clouds are in the picture: it is not the clear sky on both.
     let clear = {
-        let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+        let mut s = SpheroidRenderer::new(
+            &ctx.device,
+            &ctx.queue,
+            TARGET_FORMAT,
+            &settings,
+            p.cloud_map.noise(),
+        );
         s.update_spheroids(&[]);
         s.read_rgb8(&ctx, &r.camera(), w, h).unwrap()
     };
@@ -372,6 +390,7 @@ fn the_volume_renderer_matches_its_cpu_twin_on_a_blend() {
         &settings,
         &stack,
         params,
+        p.cloud_map.noise(),
     )
     .unwrap();
     let gpu = v.read_rgb8(&ctx, &r.camera(), w, h).unwrap();

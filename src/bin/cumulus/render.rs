@@ -364,7 +364,13 @@ fn render_spheroids(
             }
             eprintln!("backend: gpu ({})", ctx.describe());
             let settings = prepared.gpu_settings(r, r.quality());
-            let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+            let mut s = SpheroidRenderer::new(
+                &ctx.device,
+                &ctx.queue,
+                TARGET_FORMAT,
+                &settings,
+                prepared.cloud_map.noise(),
+            );
             s.update_spheroids(&spheroids);
             write_rgb8(
                 out,
@@ -446,6 +452,8 @@ fn render_endless(
             }
             eprintln!("backend: gpu ({})", ctx.describe());
             let settings = db.gpu_settings(r);
+            // The land's fields read the cloud map's detail volume.
+            let p = Prepared::unsimulated(scene)?;
             let mut v = VolumeRenderer::new(
                 &ctx.device,
                 &ctx.queue,
@@ -453,6 +461,7 @@ fn render_endless(
                 &settings,
                 &stack,
                 params,
+                p.cloud_map.noise(),
             )?;
             write_rgb8(
                 out,

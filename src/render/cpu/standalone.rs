@@ -8,8 +8,9 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::land::flat_ground_albedo;
 use super::renderer::Frame;
-use super::sky::{LAND_ALBEDO, SkyLight, aerial, background_radiance, sun_direction};
+use super::sky::{SkyLight, aerial, background_radiance, sun_direction};
 use super::waves::sea_waves_at;
 use crate::render::sampling::frame_offset;
 
@@ -90,7 +91,7 @@ pub fn render_standalone(
                     sun_dir,
                     sea_waves_at(fr.view.eye(), dir, spread, fr),
                     1.0,
-                    LAND_ALBEDO,
+                    flat_ground_albedo(fr.view.eye(), dir, spread, fr),
                     (Vec3::ZERO, 1.0),
                 );
                 *px = c.truncate() + (1.0 - c.w) * bg;

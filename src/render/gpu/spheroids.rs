@@ -11,6 +11,7 @@ use super::bind;
 use super::settings::GpuSettings;
 use super::standalone::StandalonePass;
 use crate::render::camera::Camera;
+use crate::render::noise_volume::NoiseVolume;
 
 use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::spheroids::LightGrid;
@@ -35,12 +36,14 @@ pub struct SpheroidRenderer {
 
 impl SpheroidRenderer {
     /// The renderer for a target of `format` (its settings' quality,
-    /// density scale, detail and sun are the cloud-map renderer's).
+    /// density scale, detail and sun are the cloud-map renderer's), its
+    /// land's fields reading `noise` (the cloud map's detail volume).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         format: wgpu::TextureFormat,
         settings: &GpuSettings,
+        noise: &NoiseVolume,
     ) -> Self {
         let group1_layout = bind::layout(
             device,
@@ -56,6 +59,7 @@ impl SpheroidRenderer {
             super::shaders::spheroids_pass(),
             "fs_spheroids",
             &group1_layout,
+            noise,
         );
         let buffer = Self::storage(device, "spheroids.spheroids", 32);
         let grid_buffer = Self::storage(device, "spheroids.light_grid", 16);

@@ -1,15 +1,17 @@
 //! `StandalonePass`: what the two stand-alone renderers share, the
 //! pseudo-spheroids (`spheroids.rs`) and the precomputed volumes
 //! (`volume_pass.rs`): one full-screen draw straight into the target,
-//! bind group 0 the frame uniforms alone (so the analytic sky), the
-//! settings' constants, its own bind group 1, and an 8-bit read-back for
-//! tools and tests.
+//! bind group 0 the frame uniforms (so the analytic sky) and the land's
+//! noise (the detail volume, which the fields' woods and patches read;
+//! a single texel when the land is plain), the settings' constants, its
+//! own bind group 1, and an 8-bit read-back for tools and tests.
 
-use super::bind::{self, Recorder};
+use super::bind::{self, FILTERABLE, Recorder};
 use super::settings::GpuSettings;
 use super::uniforms::{FrameInputs, FrameUniforms};
 use super::{GpuContext, GpuError};
 use crate::render::camera::Camera;
+use crate::render::noise_volume::NoiseVolume;
 
 /// One stand-alone pass: its pipeline, uniforms and target size.
 pub(super) struct StandalonePass {
@@ -26,7 +28,9 @@ pub(super) struct StandalonePass {
 
 impl StandalonePass {
     /// The pass `label` of WGSL `source`, fragment entry `entry`, for a
-    /// target of `format`, its bind group 1 laid out as `group1`.
+    /// target of `format`, its bind group 1 laid out as `group1`; `noise`
+    /// is the detail volume the land's fields read (uploaded only when
+    /// the settings draw them: `quality.land_fields`).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn new(
         device: &wgpu::Device,
@@ -37,15 +41,54 @@ impl StandalonePass {
         source: String,
         entry: &str,
         group1: &wgpu::BindGroupLayout,
+        noise: &NoiseVolume,
     ) -> Self {
         let uniforms = bind::uniform_buffer(device, label);
-        let group0_layout = bind::layout(device, label, &[bind::uniform_entry(0)]);
-        let group0 = bind::bind(
+        let group0_layout = bind::layout(
             device,
             label,
-            &group0_layout,
-            &[uniforms.as_entire_binding()],
+            &[
+                bind::uniform_entry(0),
+                bind::sampler_entry(4),
+                bind::texture_3d_entry(5, FILTERABLE),
+            ],
         );
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("standalone.wrap_linear"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let land_noise = super::textures::upload_noise_volume(
+            device,
+            queue,
+            settings.quality.land_fields.then_some(noise),
+        );
+        // The WGSL's bindings 4 and 5 of group 0 (clouds.wgsl's
+        // wrap_linear and noise_tex), not the next free ones.
+        let noise_view = bind::view(&land_noise);
+        let group0 = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &group0_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&noise_view),
+                },
+            ],
+        });
         let module = bind::module(device, label, source);
         let mut constants = settings.constants();
         constants.push(("ENCODE_SRGB", (!format.is_srgb()) as u8 as f64));

@@ -11,6 +11,7 @@ use super::standalone::StandalonePass;
 use super::{GpuContext, GpuError};
 use crate::render::camera::Camera;
 use crate::render::cpu::volume::{VolumeParams, VolumeStack};
+use crate::render::noise_volume::NoiseVolume;
 
 /// The volume renderer's WGSL.
 pub const VOLUME: &str = include_str!("../../../shaders/volume.wgsl");
@@ -27,7 +28,8 @@ pub struct VolumeRenderer {
 
 impl VolumeRenderer {
     /// The renderer of `stack` placed by `params` (its pick, the first
-    /// pair shown) for a target of `format`.
+    /// pair shown) for a target of `format`, its land's fields reading
+    /// `noise` (the cloud map's detail volume).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -35,6 +37,7 @@ impl VolumeRenderer {
         settings: &GpuSettings,
         stack: &VolumeStack,
         params: VolumeParams,
+        noise: &NoiseVolume,
     ) -> Result<Self, GpuError> {
         let [w, h, d] = stack.texture_size();
         let limit = device.limits().max_texture_dimension_3d;
@@ -92,6 +95,7 @@ impl VolumeRenderer {
             super::shaders::volume_pass(),
             "fs_volume",
             &group1_layout,
+            noise,
         );
         Ok(Self {
             queue: queue.clone(),

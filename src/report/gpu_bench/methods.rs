@@ -164,6 +164,8 @@ pub(super) fn compare_methods(
     let mut player = Player::new(&db, cfg.similarity, base.physics.seed);
     let (stack, params) = db.stack(player.at(0.0, db.interval_s));
     let settings = db.gpu_settings(r);
+    // The land's fields read the cloud map's detail volume.
+    let land = Prepared::unsimulated(base)?;
     let mut v = VolumeRenderer::new(
         &ctx.device,
         &ctx.queue,
@@ -171,6 +173,7 @@ pub(super) fn compare_methods(
         &settings,
         &stack,
         params,
+        land.cloud_map.noise(),
     )?;
     v.resize(r.width, r.height);
     let t = time_pass(ctx, r, o, |e, view, c, q| v.render(e, view, c, q))?;

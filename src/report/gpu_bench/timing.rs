@@ -54,7 +54,13 @@ pub(super) fn spheroid_renderer(
     r: &RenderSettings,
 ) -> SpheroidRenderer {
     let settings = p.gpu_settings(r, r.quality());
-    let mut s = SpheroidRenderer::new(&ctx.device, &ctx.queue, TARGET_FORMAT, &settings);
+    let mut s = SpheroidRenderer::new(
+        &ctx.device,
+        &ctx.queue,
+        TARGET_FORMAT,
+        &settings,
+        p.cloud_map.noise(),
+    );
     s.update_spheroids(&p.spheroids());
     s
 }
