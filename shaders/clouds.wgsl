@@ -809,7 +809,7 @@ fn sea_reflection(origin: vec3f, dir: vec3f, dither: f32, sun_dir: vec3f) -> vec
     let p = vec3f(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
     // The resolved waves' mirror ray; the slopes the pixel does not
     // resolve spread the reflected rays about it.
-    let waves = sea_waves(p.x, p.z, dir, frame.cam_pos.w, t_sea, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG, frame.terrain.z);
+    let waves = sea_waves_at(origin, dir);
     let r0 = sea_mirror(dir, waves);
     let across = normalize_or(vec3f(r0.x, 0.0, r0.z), vec3f(0.0, 0.0, 1.0));
     let mirror = asin(clamp(r0.y, -1.0, 1.0));

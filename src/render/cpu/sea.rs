@@ -21,7 +21,7 @@ use super::sky::{
     ground_haze_transmittance, ground_up, mirrored_sky, sea_fresnel, sea_mirror, sky_ambient,
     sun_light_at,
 };
-use super::waves::{flat_sea, sea_waves};
+use super::waves::{flat_sea, sea_waves_at};
 use crate::render::sampling::GOLDEN;
 
 /// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
@@ -155,16 +155,7 @@ pub fn sea_reflection(
     let p = Vec3::new(origin.x + dir.x * t_sea, 0.0, origin.z + dir.z * t_sea);
     // The mirror ray of the waves the pixel resolves; the slopes it does
     // not spread the reflected rays about it.
-    let waves = sea_waves(
-        p.x,
-        p.z,
-        dir,
-        spread,
-        t_sea,
-        wind,
-        q.sea_wind_toward_deg,
-        q.sea_time_s,
-    );
+    let waves = sea_waves_at(origin, dir, spread, fr).unwrap_or(flat_sea(wind));
     let r0 = sea_mirror(dir, waves);
     let across = Vec3::new(r0.x, 0.0, r0.z).normalize_or(Vec3::Z);
     let mirror = r0.y.clamp(-1.0, 1.0).asin();

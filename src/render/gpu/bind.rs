@@ -60,6 +60,21 @@ pub fn texture_3d_entry(
     texture_of(binding, sample_type, wgpu::TextureViewDimension::D3)
 }
 
+/// The repeating, trilinear sampler the WGSL's `wrap_linear` (group 0,
+/// binding 4) is: the cloud pass's and the stand-alone passes'.
+pub fn wrap_linear_sampler(device: &wgpu::Device, label: &str) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some(label),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        address_mode_w: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
+}
+
 /// A filtering sampler binding.
 pub fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     entry(

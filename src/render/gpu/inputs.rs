@@ -59,16 +59,7 @@ impl Inputs {
         let uniforms = bind::uniform_buffer(device, "clouds.frame_uniforms");
         let sky = sky.map(|p| SkyLutsPass::with_device(device, queue, p, sun_dir, 0.0));
         let layout = group0_layout(device, sky.is_some());
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("clouds.wrap_linear"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = bind::wrap_linear_sampler(device, "clouds.wrap_linear");
         let empty = ProjectedField::new(1, 1);
         let p_texture = textures::upload_field(
             device,

@@ -53,16 +53,7 @@ impl StandalonePass {
                 bind::texture_3d_entry(5, FILTERABLE),
             ],
         );
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("standalone.wrap_linear"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = bind::wrap_linear_sampler(device, "standalone.wrap_linear");
         let land_noise = super::textures::upload_noise_volume(
             device,
             queue,
