@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """How much of our error against the path tracer a correction by the
 clouds' geometry around each pixel could remove: an oracle, fitted on
-the pixels it is scored on, so an upper bound on what a light term built
-on these inputs could do.
+the pixels it is scored on (least squares on the log ratio, linear and
+with squares, no cross terms), so an estimate of what a light term
+built on these inputs could do at best, not a strict bound.
 
     python3 docs/ground_truth/compare.py --width 80 --height 60 --spp 1024 \\
         --cells 1024 --supersample 4 --cache /tmp/gt --arrays --out /tmp/gt/arrays
@@ -16,7 +17,7 @@ optical depth through the exported grid (256 cells, about 39 m) reaches
   the scale of a cloud's parts and of a whole cloud);
 - the blurred grid's extinction there (how much cloud is around);
 - the optical depth straight up, straight down and on along the view ray
-  (how deep the cloud is below, above and behind the point);
+  (how deep the cloud is above, below and behind the point);
 - its height in the band.
 
 Then it prints, per view, each feature's correlation with the log of
@@ -97,7 +98,7 @@ def corrected_error(ours, truth, cloud, mask, columns):
     """The per-pixel error after scaling ours on `mask` by exp of the
     least-squares fit of log(truth / ours) on `columns`."""
     x = np.stack([c[mask] for c in columns] + [np.ones(int(mask.sum()))], 1)
-    r = np.log(truth[mask] / ours[mask])
+    r = np.log(np.maximum(truth[mask], 1e-9) / np.maximum(ours[mask], 1e-9))
     coef, *_ = np.linalg.lstsq(x, r, rcond=None)
     fixed = ours.copy()
     fixed[mask] = ours[mask] * np.exp(x @ coef)
@@ -123,7 +124,7 @@ def main():
         def smooth(x):
             return gaussian_filter(np.where(mask, x, 0.0), 3) / np.maximum(gaussian_filter(weight, 3), 1e-6)
 
-        ratio = np.log(truth / ours)
+        ratio = np.log(np.maximum(truth, 1e-9) / np.maximum(ours, 1e-9))
         # Outside the mask both smoothed images are 0 (only the mask is read).
         with np.errstate(invalid="ignore", divide="ignore"):
             smooth_ratio = np.log(smooth(truth) / smooth(ours))
