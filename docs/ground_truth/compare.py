@@ -219,6 +219,21 @@ def cloud_pixels(name, vol_path, side, width, height):
     return (tau >= VIEW_TAU_MIN.get(name, 1.0)) & ~near_sun, tau, near_sun
 
 
+def export_view(view, binary, width, height, cells=256):
+    """The exported volume of view `view` (`cumulus export --cells
+    cells` of its scene at width x height) and its sidecar, read back."""
+    _, base, el, az, yaw = next(v for v in VIEWS if v[0] == view)
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = os.path.join(ROOT, "scenes", f".export_{view}_{os.getpid()}.toml")
+        scene_variant(base, el, az, yaw, width, height, scene, VIEW_CAMERA.get(view, {}))
+        try:
+            path = os.path.join(tmp, "v.vol")
+            run([binary, "export", "--scene", scene, "--out", path, "--cells", str(cells)])
+        finally:
+            os.remove(scene)
+        return read_vol(path).copy(), json.load(open(path[:-4] + ".json"))
+
+
 def read_vol(path):
     raw = open(path, "rb").read()
     assert raw[:4] == b"VOL\x03"

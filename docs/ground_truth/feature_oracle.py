@@ -28,10 +28,8 @@ on each feature alone and on all of them together.
 """
 
 import argparse
-import json
 import os
 import sys
-import tempfile
 
 import numpy as np
 from scipy.ndimage import gaussian_filter
@@ -42,20 +40,6 @@ import compare as C  # noqa: E402
 Y = np.array([0.2126, 0.7152, 0.0722])
 STEP_M = 5.0
 BLURS = (2, 4, 8)
-
-
-def export(view, binary, width, height):
-    """The view's volume on a 256-cell grid and its sidecar."""
-    name, base, el, az, yaw = next(v for v in C.VIEWS if v[0] == view)
-    with tempfile.TemporaryDirectory() as tmp:
-        scene = os.path.join(C.ROOT, "scenes", f".oracle_{view}_{os.getpid()}.toml")
-        C.scene_variant(base, el, az, yaw, width, height, scene, C.VIEW_CAMERA.get(view, {}))
-        try:
-            path = os.path.join(tmp, "v.vol")
-            C.run([binary, "export", "--scene", scene, "--out", path, "--cells", "256"])
-        finally:
-            os.remove(scene)
-        return C.read_vol(path).copy(), json.load(open(path[:-4] + ".json"))
 
 
 def depth_along(grid, side, start, direction, length):
@@ -117,7 +101,7 @@ def main():
         truth = np.load(os.path.join(a.arrays, f"{view}_mitsuba.npy")) @ Y
         cloud = np.load(os.path.join(a.arrays, f"{view}_cloud.npy"))
         height, width = ours.shape
-        found, feats = features(*export(view, a.bin, width, height), width, height)
+        found, feats = features(*C.export_view(view, a.bin, width, height), width, height)
         mask = cloud & found
         weight = mask.astype(float)
 

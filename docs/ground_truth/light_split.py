@@ -38,10 +38,8 @@ printed).
 """
 
 import argparse
-import json
 import os
 import sys
-import tempfile
 
 import numpy as np
 from scipy.ndimage import gaussian_filter
@@ -131,18 +129,9 @@ def view_geometry(view, binary, shape):
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import compare as C
 
-    name, base, el, az, yaw = next(v for v in C.VIEWS if v[0] == view)
     height, width = shape
-    with tempfile.TemporaryDirectory() as tmp:
-        scene = os.path.join(C.ROOT, "scenes", f".split_{view}_{os.getpid()}.toml")
-        C.scene_variant(base, el, az, yaw, width, height, scene, C.VIEW_CAMERA.get(view, {}))
-        try:
-            vol_path = os.path.join(tmp, "v.vol")
-            C.run([binary, "export", "--scene", scene, "--out", vol_path, "--cells", "256"])
-        finally:
-            os.remove(scene)
-        side = json.load(open(vol_path[:-4] + ".json"))
-        vol = C.read_vol(vol_path)
+    vol, side = C.export_view(view, binary, width, height)
+
     def sigma(p):
         return C.grid_extinction(vol, side, p)
 
