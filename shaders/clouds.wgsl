@@ -29,6 +29,7 @@ override AERIAL_PERSPECTIVE: bool = true;
 
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
+const TOP_ROUNDING: f32 = 0.8;
 const EROSION_BASE: f32 = 0.6;
 const SURFACE_RAMP: f32 = 0.08;
 const DETAIL_CONTRAST: f32 = 1.23;
@@ -72,17 +73,17 @@ const FORWARD_COS_MAX: f32 = 0.9;
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.9;
-const MULTIPLE_GAIN: f32 = 0.6;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.42;
-const MULTIPLE_SUN_POWER: f32 = 0.4;
+const MULTIPLE_GAIN: f32 = 0.53;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.46;
+const MULTIPLE_SUN_POWER: f32 = 0.2;
 const DIFFUSE_GAIN: f32 = 0.1;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const FLUENCE_GAIN: f32 = 1.23;
+const FLUENCE_GAIN: f32 = 1.19;
 // The phase function's mean cosine (the light volume's diffusion and
 // the diffused light's first-order term).
 const PHASE_MEAN_COSINE: f32 = 0.525;
-const AMBIENT_GAIN: f32 = 4.3;
-const GROUND_LIGHT_GAIN: f32 = 4.18;
+const AMBIENT_GAIN: f32 = 4.37;
+const GROUND_LIGHT_GAIN: f32 = 3.82;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
@@ -322,12 +323,19 @@ fn world_footprint(x: f32, z: f32, l: vec3f, footprint_m: f32, eta: f32) -> vec4
     return vec4f(fp.x * mix(1.0, weather(x, z), k), fp.y, fp.z, fp.w);
 }
 
+// The highest value of the mixed field (the CPU's `field_max`).
+fn field_max(s: f32) -> f32 {
+    return cloud_field(1.0, 1.0, s);
+}
+
 // The threshold the cloud field must exceed (the CPU's
 // `cumulus_threshold`): lowest just above the flat base, a dome rising to
-// 1 at the local top.
-fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
+// 1 at the local top, and over the top fifth on to the field's highest
+// value, so no core is cut off flat at the top.
+fn cumulus_threshold(eta: f32, top: f32, cover: f32, s: f32) -> f32 {
     let t = eta / top;
-    return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0);
+    return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0)
+        + (field_max(s) - 1.0) * smoothstep(TOP_ROUNDING, 1.0, t);
 }
 
 // The detail noise's weight, growing with height (the CPU's
@@ -400,8 +408,8 @@ fn density_at(p: vec3f, detail: bool, footprint_m: f32) -> f32 {
     if fp.x <= 0.0 || eta >= fp.y {
         return 0.0;
     }
-    let threshold = cumulus_threshold(eta, fp.y, fp.x);
     let s = erosion_strength(frame.map.y, eta, fp.y);
+    let threshold = cumulus_threshold(eta, fp.y, fp.x, s);
     if cloud_field(fp.w, 1.0, s) < threshold {
         return 0.0;
     }

@@ -457,16 +457,34 @@ pub fn world_footprint(
     (cover * (1.0 + k * (weather(x, z) - 1.0)), top, fill, m)
 }
 
-/// The cumulus field's threshold at normalised height `eta` under a local
-/// top `top` where the parcels ask for a cloud fraction `cover`: the
-/// field must exceed it for cloud. Lowest just above the flat base (the
-/// widest part of a cumulus), rising as a dome `1 - (η/top)²` to 1 (no
-/// cloud) at the top, so the clouds that the field's high points make
-/// are flat-based and domed, taller where the field is higher.
+/// The fraction of the local top above which [`cumulus_threshold`] climbs
+/// on from 1 to the cloud field's highest value ([`field_max`]).
+pub const TOP_ROUNDING: f32 = 0.8;
+
+/// The highest value [`cloud_field`] takes at mix `s` (map and noise both
+/// 1): 1 for the map alone, up to 1.21 for an even mix.
 #[inline]
-pub fn cumulus_threshold(eta: f32, top: f32, cover: f32) -> f32 {
+pub fn field_max(s: f32) -> f32 {
+    cloud_field(1.0, 1.0, s)
+}
+
+/// The cumulus field's threshold at normalised height `eta` under a local
+/// top `top` where the parcels ask for a cloud fraction `cover`, for the
+/// field mixed by `s`: the field must exceed it for cloud. Lowest just
+/// above the flat base (the widest part of a cumulus), rising as a dome
+/// `1 - (η/top)²` to 1 at the top, so the clouds that the field's high
+/// points make are flat-based and domed, taller where the field is
+/// higher. Over the top fifth ([`TOP_ROUNDING`]) it climbs on to the
+/// field's highest value, which it reaches at the top: the mixed field
+/// exceeds 1 in a cloud's core, and a threshold that stopped at 1 left
+/// the core cut off flat at the local top, a smooth surface that read as
+/// a ruler-straight lid at the horizon (docs/view_horizon.png until
+/// 2026-12-05). Now the noise rounds every top off below it.
+#[inline]
+pub fn cumulus_threshold(eta: f32, top: f32, cover: f32, s: f32) -> f32 {
     let t = eta / top;
     1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0)
+        + (field_max(s) - 1.0) * smoothstep(TOP_ROUNDING, 1.0, t)
 }
 
 /// Spread of [`detail_noise`] about its mean 0.5 is widened by this to
@@ -535,8 +553,8 @@ pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool, footprin
     if cover <= 0.0 || eta >= top {
         return 0.0;
     }
-    let threshold = cumulus_threshold(eta, top, cover);
     let s = erosion_strength(d.detail_strength, eta, top);
+    let threshold = cumulus_threshold(eta, top, cover, s);
     // The highest the field can be here: skip the noise when even that
     // stays under the threshold.
     if cloud_field(m, 1.0, s) < threshold {

@@ -100,3 +100,33 @@ fn detail_contrast_matches_the_volume() {
         "sd {sd} near, {very_far} at 2 km"
     );
 }
+
+/// No cloud is cut off flat at its local top: even the field's highest
+/// value (map and noise both 1, above 1 for any mix) fades out before
+/// the top, whatever the mix, the cover and the top. With a threshold
+/// that stopped at 1 a mixed field's core kept its full density up to
+/// the top (the profile 1 at `s` 0.6) and ended in a flat lid.
+#[test]
+fn cloud_tops_are_rounded_not_cut() {
+    for s in [0.0, 0.3, 0.6, 1.0] {
+        for cover in [0.2, 0.6, 1.0] {
+            for top in [0.3, 0.7, 1.0] {
+                let near_top = |eta: f32| {
+                    let threshold = cumulus_threshold(eta, top, cover, s);
+                    surface_profile(1.0, 1.0, s, threshold)
+                };
+                let at_top = near_top(0.9999 * top);
+                assert!(
+                    at_top < 0.01,
+                    "s {s} cover {cover} top {top}: {at_top} at the top"
+                );
+                // Below the rounding the dome is as it was: the core is whole.
+                let below = near_top(0.7 * top);
+                assert!(
+                    below > 0.99,
+                    "s {s} cover {cover} top {top}: {below} under the top"
+                );
+            }
+        }
+    }
+}
