@@ -9,6 +9,8 @@
 # Writes OUTDIR/cumulus_{zero,mf,mi,di,fl,am,gr}. Edits the two source files
 # that hold the gains in place and restores them on exit (also on error
 # or Ctrl-C), then rebuilds the shipped binary. About a minute a build.
+# Honours CARGO_TARGET_DIR (builds there, so a binary another script is
+# running from target/ is left alone).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:?usage: gain_parts.sh OUTDIR}
@@ -35,7 +37,7 @@ for v in zero mf mi di fl am gr; do
   sed -i "s/^pub const AMBIENT_GAIN: f32 = .*/pub const AMBIENT_GAIN: f32 = $am;/;
           s/^pub const GROUND_LIGHT_GAIN: f32 = .*/pub const GROUND_LIGHT_GAIN: f32 = $gr;/" "$R"
   cargo build --release --bin cumulus
-  cp target/release/cumulus "$out/cumulus_$v"
+  cp "${CARGO_TARGET_DIR:-target}/release/cumulus" "$out/cumulus_$v"
 done
 restore
 trap - EXIT

@@ -195,7 +195,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// ([`ambient_light`]), times this, which stands for that light's own
 /// multiple scattering; fitted with the octaves and the diffused sunlight
 /// ([`super::lighting::sun_scattering`]) and [`GROUND_LIGHT_GAIN`].
-pub const AMBIENT_GAIN: f32 = 4.3;
+pub const AMBIENT_GAIN: f32 = 4.37;
 
 /// The gain on the ground's light in cloud (`GROUND_LIGHT_GAIN` in
 /// WGSL): isotropic scattering of the ground's upward irradiance
@@ -205,7 +205,7 @@ pub const AMBIENT_GAIN: f32 = 4.3;
 /// 2026-12-04 it kept 0.35 at the top under the sky's gain, and the path
 /// tracer measured the change (docs/ground_truth: summed per-pixel error
 /// over its four views 45.3 → 44.8 points, the high sun's 11.2 → 10.7 %).
-pub const GROUND_LIGHT_GAIN: f32 = 4.18;
+pub const GROUND_LIGHT_GAIN: f32 = 3.82;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4`, weighted
