@@ -233,11 +233,13 @@ pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.46;
 /// the gains on the rounded tops (docs/ground_truth, 2026-12-05),
 /// summed per-pixel error over the four views with the tops held within
 /// 9.5 %: 44.9 at 0.4 (the high sun 11.2 %), 44.2 at 0.3, 43.6 at 0.2,
-/// 43.5 at 0.1 and at 0; 0.2 keeps the low sun nearest 10 % (10.0 %;
-/// 10.2 % at 0.1, 10.4 % at 0) with the high sun under it (9.9 %).
+/// 43.5 at 0.1 and at 0. 0.2 is the one power with both the high and
+/// the low sun at about 10 % or under (9.9 and 10.0 %; at 0.3 the high
+/// sun is 10.6 %, at 0.1 and 0 the low sun 10.2 and 10.4 %).
 pub const MULTIPLE_SUN_POWER: f32 = 0.2;
 /// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
-/// zenith. Held at 0.1 in the last fit (docs/ground_truth, 2026-12-04):
+/// zenith. Held at 0.1 in the last fits (docs/ground_truth, 2026-12-04
+/// and 2026-12-05):
 /// beside the light volume the free fit takes it to 0, for 0.16 points
 /// of summed error, but the renderers that build no light volume (the
 /// spheroids' and the volume's) have only this to fill deep cloud.
