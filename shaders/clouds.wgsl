@@ -30,6 +30,8 @@ override AERIAL_PERSPECTIVE: bool = true;
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
 const TOP_ROUNDING: f32 = 0.8;
+const P_COVERAGE_MIN: f32 = 1e-3;
+const FRINGE_PRESENCE: f32 = 0.005;
 const EROSION_BASE: f32 = 0.6;
 const SURFACE_RAMP: f32 = 0.08;
 const DETAIL_CONTRAST: f32 = 1.23;
@@ -256,7 +258,7 @@ fn coarse_empty(u: f32, v: f32) -> bool {
 fn footprint(u: f32, v: f32, map_lod: f32, eta: f32) -> vec4f {
     let pf = textureSampleLevel(p_tex, wrap_linear, vec2f(u, v), 0.0);
     let highest = clamp(0.2 + 0.8 * pf.g, 0.0, 1.0);
-    if pf.r <= 1e-3 || eta >= highest {
+    if pf.r <= P_COVERAGE_MIN || eta >= highest {
         return vec4f(0.0);
     }
     let cm = textureSampleLevel(cm_tex, wrap_linear, vec2f(u, v), map_lod);
@@ -331,11 +333,15 @@ fn field_max(s: f32) -> f32 {
 // The threshold the cloud field must exceed (the CPU's
 // `cumulus_threshold`): lowest just above the flat base, a dome rising to
 // 1 at the local top, and over the top fifth on to the field's highest
-// value, so no core is cut off flat at the top.
-fn cumulus_threshold(eta: f32, top: f32, cover: f32, s: f32) -> f32 {
+// value, so no core is cut off flat at the top; the same climb where the
+// presence (P's spread coverage times the weather) falls under
+// FRINGE_PRESENCE, so clouds end before P's coverage does.
+fn cumulus_threshold(eta: f32, top: f32, cover: f32, presence: f32, s: f32) -> f32 {
     let t = eta / top;
+    let fringe = 1.0 - smoothstep(P_COVERAGE_MIN, FRINGE_PRESENCE, presence);
+    let climb = max(smoothstep(TOP_ROUNDING, 1.0, t), fringe);
     return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0)
-        + (field_max(s) - 1.0) * smoothstep(TOP_ROUNDING, 1.0, t);
+        + (field_max(s) - 1.0) * climb;
 }
 
 // The detail noise's weight, growing with height (the CPU's
@@ -409,7 +415,8 @@ fn density_at(p: vec3f, detail: bool, footprint_m: f32) -> f32 {
         return 0.0;
     }
     let s = erosion_strength(frame.map.y, eta, fp.y);
-    let threshold = cumulus_threshold(eta, fp.y, fp.x, s);
+    let presence = fp.x / max(frame.band.z, 1e-6);
+    let threshold = cumulus_threshold(eta, fp.y, fp.x, presence, s);
     if cloud_field(fp.w, 1.0, s) < threshold {
         return 0.0;
     }

@@ -334,7 +334,7 @@ pub fn footprint(
 ) -> (f32, f32, f32, f32) {
     let [c, h, fill] = f.p.sample(u, v);
     let highest = (0.2 + 0.8 * h).clamp(0.0, 1.0);
-    if c <= 1e-3 || eta >= highest {
+    if c <= P_COVERAGE_MIN || eta >= highest {
         return (0.0, 0.0, 0.0, 0.0);
     }
     let [m, large] = f.cloud_map.sample_level(u, v, map_lod);
@@ -468,6 +468,30 @@ pub fn field_max(s: f32) -> f32 {
     cloud_field(1.0, 1.0, s)
 }
 
+/// P's spread coverage at and under which [`footprint`] finds no cloud
+/// (`P_COVERAGE_MIN` in WGSL).
+pub const P_COVERAGE_MIN: f32 = 1e-3;
+
+/// The presence ([`cumulus_threshold`]'s `presence`: P's spread coverage
+/// times the weather, the scene's coverage divided out) under which the
+/// threshold climbs on toward the field's highest value ([`field_max`]),
+/// reaching it at [`P_COVERAGE_MIN`]: the clouds shrink to nothing at
+/// the fringe of the parcels' spread coverage. The mixed field exceeds 1
+/// over a few percent of the sky (the tail of a sum of two uniform
+/// fields; the small clouds where a lone parcel's coverage is low), so a
+/// threshold that stopped at 1 as the cover went to 0 left cloud up to
+/// where P's spread coverage ended (the soft field's kernel, cut off at
+/// three deviations, or `footprint`'s cut at [`P_COVERAGE_MIN`]) and
+/// sliced it there: vertical walls that read as
+/// straight cut edges seen from below (docs/view_below_base.png until
+/// 2026-12-05). With the soft field's tapered Gaussian the fringe, where
+/// the coverage falls from 0.5 % to 0.1 %, is about 150 m wide, beside a
+/// lone parcel and a cluster alike. The clouds it takes away are specks
+/// more than a kilometre from any condensed parcel: BOMEX's cloud
+/// fraction 0.184 -> 0.174 (`cumulus stats`), fair weather's 0.293 ->
+/// 0.291; a fringe up to 2 % took BOMEX's to 0.160.
+pub const FRINGE_PRESENCE: f32 = 0.005;
+
 /// The cumulus field's threshold at normalised height `eta` under a local
 /// top `top` where the parcels ask for a cloud fraction `cover`, for the
 /// field mixed by `s`: the field must exceed it for cloud. Lowest just
@@ -479,12 +503,17 @@ pub fn field_max(s: f32) -> f32 {
 /// exceeds 1 in a cloud's core, and a threshold that stopped at 1 left
 /// the core cut off flat at the local top, a smooth surface that read as
 /// a ruler-straight lid at the horizon (docs/view_horizon.png until
-/// 2026-12-05). Now the noise rounds every top off below it.
+/// 2026-12-05). Now the noise rounds every top off below it. Where the
+/// `presence` (P's spread coverage times the weather) falls under
+/// [`FRINGE_PRESENCE`] it climbs the same way, so clouds end before P
+/// does, not at its edge; over it the threshold is the same, bit for bit.
 #[inline]
-pub fn cumulus_threshold(eta: f32, top: f32, cover: f32, s: f32) -> f32 {
+pub fn cumulus_threshold(eta: f32, top: f32, cover: f32, presence: f32, s: f32) -> f32 {
     let t = eta / top;
+    let fringe = 1.0 - smoothstep(P_COVERAGE_MIN, FRINGE_PRESENCE, presence);
+    let climb = smoothstep(TOP_ROUNDING, 1.0, t).max(fringe);
     1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0)
-        + (field_max(s) - 1.0) * smoothstep(TOP_ROUNDING, 1.0, t)
+        + (field_max(s) - 1.0) * climb
 }
 
 /// Spread of [`detail_noise`] about its mean 0.5 is widened by this to
@@ -554,7 +583,8 @@ pub fn density_at(p: Vec3, f: &Fields, d: &DensityParams, detail: bool, footprin
         return 0.0;
     }
     let s = erosion_strength(d.detail_strength, eta, top);
-    let threshold = cumulus_threshold(eta, top, cover, s);
+    let presence = cover / d.coverage.max(1e-6);
+    let threshold = cumulus_threshold(eta, top, cover, presence, s);
     // The highest the field can be here: skip the noise when even that
     // stays under the threshold.
     if cloud_field(m, 1.0, s) < threshold {

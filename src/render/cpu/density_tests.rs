@@ -112,7 +112,7 @@ fn cloud_tops_are_rounded_not_cut() {
         for cover in [0.2, 0.6, 1.0] {
             for top in [0.3, 0.7, 1.0] {
                 let near_top = |eta: f32| {
-                    let threshold = cumulus_threshold(eta, top, cover, s);
+                    let threshold = cumulus_threshold(eta, top, cover, 1.0, s);
                     surface_profile(1.0, 1.0, s, threshold)
                 };
                 let at_top = near_top(0.9999 * top);
@@ -126,6 +126,46 @@ fn cloud_tops_are_rounded_not_cut() {
                     below > 0.99,
                     "s {s} cover {cover} top {top}: {below} under the top"
                 );
+            }
+        }
+    }
+}
+
+/// Clouds end before the parcels' spread coverage does. `footprint`
+/// cuts the density off where P's coverage falls to 1e-3; with a
+/// threshold that went to 1 as the cover went to 0, the mixed field's
+/// values over 1 (map and noise both high) kept their full density up to
+/// that contour and ended in a vertical wall there (the profile 1 at `s`
+/// 0.3 and 0.6). Now the densest field fades out before it, grows back
+/// smoothly over the fringe, and from [`FRINGE_PRESENCE`] on the
+/// threshold is the one without a fringe, for any scene coverage.
+#[test]
+fn clouds_fade_out_at_the_fringe_of_the_parcels_coverage() {
+    let (eta, top) = (0.3, 0.8);
+    for s in [0.0, 0.3, 0.6, 1.0] {
+        for coverage in [0.1, 0.6, 1.0] {
+            let threshold =
+                |presence: f32| cumulus_threshold(eta, top, coverage * presence, presence, s);
+            let densest = |presence: f32| surface_profile(1.0, 1.0, s, threshold(presence));
+            let at_cut = densest(1e-3);
+            assert!(
+                at_cut < 0.02,
+                "s {s} coverage {coverage}: {at_cut} where P's coverage ends"
+            );
+            let mut last = at_cut;
+            for i in 1..=2000 {
+                let now = densest(1e-3 + 0.02 * i as f32 / 2000.0);
+                assert!(
+                    now >= last && now - last < 0.05,
+                    "s {s} coverage {coverage}: {last} -> {now} at step {i}"
+                );
+                last = now;
+            }
+            for presence in [FRINGE_PRESENCE, 0.5, 1.0] {
+                let cover = coverage * presence;
+                let t = eta / top;
+                let plain = 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0);
+                assert_eq!(threshold(presence), plain, "s {s} coverage {coverage}");
             }
         }
     }
