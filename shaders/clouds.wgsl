@@ -32,6 +32,7 @@ const BASE_RAMP: f32 = 0.04;
 const TOP_ROUNDING: f32 = 0.8;
 const P_COVERAGE_MIN: f32 = 1e-3;
 const FRINGE_PRESENCE: f32 = 0.005;
+const WEATHER_MAX: f32 = 1.4;
 const EROSION_BASE: f32 = 0.6;
 const SURFACE_RAMP: f32 = 0.08;
 const DETAIL_CONTRAST: f32 = 1.23;
@@ -291,7 +292,7 @@ fn weather(x: f32, z: f32) -> f32 {
     let a = x / WEATHER_SCALE_M;
     let b = z / WEATHER_SCALE_M;
     let g = 0.5 + 0.25 * (sin(a + 0.4) * sin(b * 0.81 + 1.9) + sin((0.6 * a + 0.8 * b) * 1.37 + 2.7));
-    return 1.4 * smoothstep(0.25, 0.75, g);
+    return WEATHER_MAX * smoothstep(0.25, 0.75, g);
 }
 
 // Where world (x, z) reads P and the map: (u, v) through the weighted
@@ -338,7 +339,7 @@ fn field_max(s: f32) -> f32 {
 // FRINGE_PRESENCE, so clouds end before P's coverage does.
 fn cumulus_threshold(eta: f32, top: f32, cover: f32, presence: f32, s: f32) -> f32 {
     let t = eta / top;
-    let fringe = 1.0 - smoothstep(P_COVERAGE_MIN, FRINGE_PRESENCE, presence);
+    let fringe = 1.0 - smoothstep(P_COVERAGE_MIN * WEATHER_MAX, FRINGE_PRESENCE, presence);
     let climb = max(smoothstep(TOP_ROUNDING, 1.0, t), fringe);
     return 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * max(1.0 - t * t, 0.0)
         + (field_max(s) - 1.0) * climb;

@@ -81,6 +81,45 @@ fn density_is_zero_outside_the_band_and_where_coverage_is_zero() {
     );
 }
 
+/// No cloud ends in a wall where the parcels' spread coverage ends. At a
+/// coverage just over `footprint`'s cut (0.1 %), the mixed field's
+/// highest values made full-density cloud up to the cut, inside the
+/// simulated domain and in the warped sky around it (where the weather
+/// multiplies the cover by up to 1.4); now the density there is nearly
+/// 0, while a coverage of a few percent still makes dense cloud.
+#[test]
+fn clouds_fade_out_before_the_coverage_cut() {
+    let cm = cloud_map();
+    let d = DensityParams {
+        detail_strength: 0.5,
+        ..D
+    };
+    let densest = |coverage: f32| {
+        let p = ProjectedField::uniform(32, 32, [coverage, 0.8, 1.0]);
+        let f = Fields {
+            p: &p,
+            cloud_map: &cm,
+        };
+        let mut most: f32 = 0.0;
+        for i in 0..20_000 {
+            let t = i as f32;
+            // Inside the domain and far outside it (the warp and the
+            // weather at full weight).
+            let far = if i % 2 == 0 { 0.0 } else { 40_000.0 };
+            let x = far + (t * 0.618_034).fract() * 10_000.0;
+            let z = far + (t * 0.414_213).fract() * 10_000.0;
+            let y = 620.0 + (t * 0.732_05).fract() * 600.0;
+            most = most.max(density_at(Vec3::new(x, y, z), &f, &d, true, 0.0));
+        }
+        most
+    };
+    let full = d.extinction_per_m;
+    let at_cut = densest(1.05e-3);
+    assert!(at_cut < 0.02 * full, "{at_cut} at the cut, {full} full");
+    let cloudy = densest(0.05);
+    assert!(cloudy > 0.5 * full, "{cloudy} at 5 % coverage");
+}
+
 /// The base is flat: across a cloud, density switches on within the
 /// same height ramp everywhere (BASE_RAMP of the band, 40 m here).
 #[test]

@@ -93,6 +93,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("TOP_ROUNDING", density::TOP_ROUNDING as f64),
         ("FRINGE_PRESENCE", density::FRINGE_PRESENCE as f64),
         ("P_COVERAGE_MIN", density::P_COVERAGE_MIN as f64),
+        ("WEATHER_MAX", density::WEATHER_MAX as f64),
         ("EROSION_BASE", density::EROSION_BASE as f64),
         ("SURFACE_RAMP", density::SURFACE_RAMP as f64),
         ("DETAIL_CONTRAST", density::DETAIL_CONTRAST as f64),

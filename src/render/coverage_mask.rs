@@ -11,7 +11,7 @@ use crate::sim::ProjectedField;
 
 /// Coverage at or below which P's texel counts as empty (the density's own
 /// threshold, `footprint`).
-pub const EMPTY_COVERAGE: f32 = 1e-3;
+pub const EMPTY_COVERAGE: f32 = crate::render::cpu::density::P_COVERAGE_MIN;
 
 /// P texels per mask cell along each axis.
 pub const CELL: usize = 8;

@@ -64,26 +64,15 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
 }
 
 /// The normalised Gaussian of `sigma_m` sampled at texels of `texel_m`
-/// along an axis of `n` texels, tapered to 0 at its ends: three standard
-/// deviations each side, but never wider than the field itself (a kernel
-/// wider than a period is nearly flat there anyway), so the cost stays
-/// within texels x width. The Gaussian's value one texel past the end is
-/// subtracted
-/// (1.1 % of the peak at three deviations), so the spread coverage falls
-/// to 0 continuously at the edge of the kernel's square support: cut off
-/// there, a cluster's coverage dropped from a few percent to 0 along
-/// straight lines, and the clouds the field's highest values make at such
-/// low cover ended in straight vertical walls (docs/view_below_base.png
-/// until 2026-12-05; `density::FRINGE_PRESENCE`).
+/// along an axis of `n` texels: three standard deviations each side, but
+/// never wider than the field itself (a kernel wider than a period is
+/// nearly flat there anyway), so the cost stays within texels x width.
 fn gaussian_kernel(sigma_m: f32, texel_m: f32, n: usize) -> Vec<f32> {
     let s = (sigma_m / texel_m).max(1e-3);
-    let full = (3.0 * s).ceil() as i64;
-    let r = full.min((n as i64 - 1) / 2);
-    let gauss = |x: f32| (-0.5 * (x / s).powi(2)).exp();
-    // A kernel cut to the field's width wraps around the whole period:
-    // it has no edge to taper.
-    let end = if r < full { 0.0 } else { gauss(r as f32 + 1.0) };
-    let k: Vec<f32> = (-r..=r).map(|i| (gauss(i as f32) - end).max(0.0)).collect();
+    let r = ((3.0 * s).ceil() as i64).min((n as i64 - 1) / 2);
+    let k: Vec<f32> = (-r..=r)
+        .map(|i| (-0.5 * (i as f32 / s).powi(2)).exp())
+        .collect();
     let sum: f32 = k.iter().sum();
     k.into_iter().map(|x| x / sum).collect()
 }
@@ -233,24 +222,6 @@ mod tests {
         }
     }
 
-    /// The spread coverage falls to 0 at the kernel's edge without a
-    /// step: a lone parcel's outermost spread texel holds under 0.3 % of
-    /// its centre's (the untapered Gaussian left 1.1 %, exp(-4.5), and
-    /// a cluster's few percent ended there in a straight wall of cloud).
-    #[test]
-    fn the_spread_coverage_ends_without_a_step() {
-        // 400 m over 25 m texels: 16 texels a deviation, 48 each side.
-        let (n, texel) = (160, 25.0);
-        let mut texels = vec![[0.0; 3]; n * n];
-        texels[80 * n + 80] = [1.0, 0.5, 0.5];
-        let p = ProjectedField::from_texels(n, n, texels).expect("size");
-        let s = soft_field(&p, 400.0, n as f32 * texel);
-        let centre = s.at(80, 80)[0];
-        let last = s.at(80 + 48, 80)[0];
-        assert!(last > 0.0 && last < 0.003 * centre, "{last} vs {centre}");
-        assert_eq!(s.at(80 + 49, 80)[0], 0.0);
-    }
-
     #[test]
     fn a_uniform_field_stays_uniform_and_a_lone_texel_spreads_and_keeps_its_height() {
         let p = ProjectedField::uniform(32, 32, [1.0, 0.6, 0.8]);
@@ -266,10 +237,9 @@ mod tests {
         assert!((total - 1.0).abs() < 1e-4, "coverage conserved: {total}");
         // Spread across the periodic edge, with the texel's height: a
         // Gaussian of two texels (200 m over 100 m texels) gives the
-        // neighbour k(1)·k(0) of the normalised weights, the Gaussian
-        // tapered by its value one texel past the kernel's end.
+        // neighbour k(1)·k(0) of the normalised weights.
         let k: Vec<f32> = (-6..=6_i32)
-            .map(|i| (-(i * i) as f32 / 8.0).exp() - (-49.0_f32 / 8.0).exp())
+            .map(|i| (-(i * i) as f32 / 8.0).exp())
             .collect();
         let sum: f32 = k.iter().sum();
         let want = k[7] / sum * k[6] / sum;

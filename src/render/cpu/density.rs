@@ -400,7 +400,10 @@ pub fn warp_weight(x: f32, z: f32, extent_m: f32) -> f32 {
 /// Length scale of the weather modulation, m (wavelengths of 14-25 km).
 pub const WEATHER_SCALE_M: f32 = 3000.0;
 
-/// The weather modulation at world `(x, z)`, 0..=1.4, multiplying the
+/// The most the [`weather`] multiplies the cover by (`WEATHER_MAX`).
+pub const WEATHER_MAX: f32 = 1.4;
+
+/// The weather modulation at world `(x, z)`, 0..=[`WEATHER_MAX`], multiplying the
 /// cover P asks for: sines of incommensurate wavelengths of 14-25 km, so
 /// over tens of kilometres the sky has banks of cloud and clear patches
 /// that do not follow the domain's tiling.
@@ -410,7 +413,7 @@ pub fn weather(x: f32, z: f32) -> f32 {
     let g = 0.5
         + 0.25
             * ((a + 0.4).sin() * (b * 0.81 + 1.9).sin() + ((0.6 * a + 0.8 * b) * 1.37 + 2.7).sin());
-    1.4 * smoothstep(0.25, 0.75, g)
+    WEATHER_MAX * smoothstep(0.25, 0.75, g)
 }
 
 /// Where world `(x, z)` reads P and the cloud map: map coordinates through
@@ -475,21 +478,22 @@ pub const P_COVERAGE_MIN: f32 = 1e-3;
 /// The presence ([`cumulus_threshold`]'s `presence`: P's spread coverage
 /// times the weather, the scene's coverage divided out) under which the
 /// threshold climbs on toward the field's highest value ([`field_max`]),
-/// reaching it at [`P_COVERAGE_MIN`]: the clouds shrink to nothing at
-/// the fringe of the parcels' spread coverage. The mixed field exceeds 1
-/// over a few percent of the sky (the tail of a sum of two uniform
-/// fields; the small clouds where a lone parcel's coverage is low), so a
-/// threshold that stopped at 1 as the cover went to 0 left cloud up to
-/// where P's spread coverage ended (the soft field's kernel, cut off at
-/// three deviations, or `footprint`'s cut at [`P_COVERAGE_MIN`]) and
-/// sliced it there: vertical walls that read as
-/// straight cut edges seen from below (docs/view_below_base.png until
-/// 2026-12-05). With the soft field's tapered Gaussian the fringe, where
-/// the coverage falls from 0.5 % to 0.1 %, is about 150 m wide, beside a
-/// lone parcel and a cluster alike. The clouds it takes away are specks
-/// more than a kilometre from any condensed parcel: BOMEX's cloud
-/// fraction 0.184 -> 0.174 (`cumulus stats`), fair weather's 0.293 ->
-/// 0.291; a fringe up to 2 % took BOMEX's to 0.160.
+/// reaching it (less the cover's own small term) at [`WEATHER_MAX`] times
+/// [`P_COVERAGE_MIN`], the highest presence at `footprint`'s cut: the
+/// clouds shrink to nothing at the fringe of the parcels' spread
+/// coverage. The mixed field exceeds 1 over a few percent of the sky (the
+/// tail of a sum of two uniform fields; the small clouds where a lone
+/// parcel's coverage is low), so a threshold that stopped at 1 as the
+/// cover went to 0 left cloud at any coverage however low, up to the cut,
+/// and sliced it there: vertical walls along the contour of 0.1 %
+/// coverage, seen from below as straight cut edges
+/// (docs/view_below_base.png until 2026-12-05). Beside the soft field's
+/// Gaussian the fringe, where the coverage falls from 0.5 % to 0.14 %, is
+/// about 140 m wide, by a lone parcel and a cluster alike. The clouds it
+/// takes away are specks more than a kilometre from any condensed
+/// parcel: BOMEX's cloud fraction 0.184 -> 0.175 (`cumulus stats`), fair
+/// weather's 0.293 -> 0.291; a fringe up to 2 % (tried from 0 coverage)
+/// took BOMEX's to 0.160.
 pub const FRINGE_PRESENCE: f32 = 0.005;
 
 /// The cumulus field's threshold at normalised height `eta` under a local
@@ -510,7 +514,7 @@ pub const FRINGE_PRESENCE: f32 = 0.005;
 #[inline]
 pub fn cumulus_threshold(eta: f32, top: f32, cover: f32, presence: f32, s: f32) -> f32 {
     let t = eta / top;
-    let fringe = 1.0 - smoothstep(P_COVERAGE_MIN, FRINGE_PRESENCE, presence);
+    let fringe = 1.0 - smoothstep(P_COVERAGE_MIN * WEATHER_MAX, FRINGE_PRESENCE, presence);
     let climb = smoothstep(TOP_ROUNDING, 1.0, t).max(fringe);
     1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0)
         + (field_max(s) - 1.0) * climb

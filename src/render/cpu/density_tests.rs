@@ -147,12 +147,13 @@ fn clouds_fade_out_at_the_fringe_of_the_parcels_coverage() {
             let threshold =
                 |presence: f32| cumulus_threshold(eta, top, coverage * presence, presence, s);
             let densest = |presence: f32| surface_profile(1.0, 1.0, s, threshold(presence));
-            let at_cut = densest(1e-3);
+            // Where P's coverage ends, under the strongest weather too.
+            let at_cut = densest(1e-3).max(densest(WEATHER_MAX * P_COVERAGE_MIN));
             assert!(
                 at_cut < 0.02,
                 "s {s} coverage {coverage}: {at_cut} where P's coverage ends"
             );
-            let mut last = at_cut;
+            let mut last = densest(1e-3);
             for i in 1..=2000 {
                 let now = densest(1e-3 + 0.02 * i as f32 / 2000.0);
                 assert!(
@@ -161,11 +162,18 @@ fn clouds_fade_out_at_the_fringe_of_the_parcels_coverage() {
                 );
                 last = now;
             }
+            // Beyond the fringe the threshold is the one without it, at
+            // a top climbing (eta 0.9 of the top) or not.
             for presence in [FRINGE_PRESENCE, 0.5, 1.0] {
                 let cover = coverage * presence;
-                let t = eta / top;
-                let plain = 1.0 - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0);
-                assert_eq!(threshold(presence), plain, "s {s} coverage {coverage}");
+                for eta in [eta, 0.9 * top] {
+                    let t = eta / top;
+                    let plain = 1.0
+                        - cover * smoothstep(0.0, BASE_RAMP, eta) * (1.0 - t * t).max(0.0)
+                        + (field_max(s) - 1.0) * smoothstep(TOP_ROUNDING, 1.0, t);
+                    let now = cumulus_threshold(eta, top, cover, presence, s);
+                    assert_eq!(now, plain, "s {s} coverage {coverage} eta {eta}");
+                }
             }
         }
     }
