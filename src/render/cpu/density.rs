@@ -492,7 +492,7 @@ pub const P_COVERAGE_MIN: f32 = 1e-3;
 /// about 140 m wide, by a lone parcel and a cluster alike. The clouds it
 /// takes away are specks more than a kilometre from any condensed
 /// parcel: BOMEX's cloud fraction 0.184 -> 0.175 (`cumulus stats`), fair
-/// weather's 0.293 -> 0.291; a fringe up to 2 % (tried from 0 coverage)
+/// weather's 0.293 -> 0.292; a fringe up to 2 % (tried from 0 coverage)
 /// took BOMEX's to 0.160.
 pub const FRINGE_PRESENCE: f32 = 0.005;
 
