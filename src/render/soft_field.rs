@@ -101,8 +101,9 @@ fn gaussian_kernel(sigma_m: f32, texel_m: f32, n: usize) -> Vec<f32> {
 
 /// `src` (`w x h`, row-major) convolved with the centred kernel `k` along
 /// rows (`along_x`) or columns, periodically; `k` is at most `w + 1`
-/// (rows) or `h + 1` (columns) long (a kernel wrapped onto an even axis), and `w` and `h` are at least 1 ([`soft_field`]
-/// returns early otherwise). Rows run in parallel; each texel sums its
+/// (rows) or `h + 1` (columns) long (a kernel wrapped onto an even
+/// axis), and `w` and `h` are at least 1 ([`soft_field`] returns early
+/// otherwise). Rows run in parallel; each texel sums its
 /// taps in the kernel's order, so the result does not depend on the
 /// threads.
 fn blur_axis(src: &[[f32; 3]], w: usize, h: usize, k: &[f32], along_x: bool) -> Vec<[f32; 3]> {

@@ -476,24 +476,15 @@ pub fn field_max(s: f32) -> f32 {
 pub const P_COVERAGE_MIN: f32 = 1e-3;
 
 /// The presence ([`cumulus_threshold`]'s `presence`: P's spread coverage
-/// times the weather, the scene's coverage divided out) under which the
-/// threshold climbs on toward the field's highest value ([`field_max`]),
-/// reaching it (less the cover's own small term) at [`WEATHER_MAX`] times
-/// [`P_COVERAGE_MIN`], the highest presence at `footprint`'s cut: the
-/// clouds shrink to nothing at the fringe of the parcels' spread
-/// coverage. The mixed field exceeds 1 over a few percent of the sky (the
-/// tail of a sum of two uniform fields; the small clouds where a lone
-/// parcel's coverage is low), so a threshold that stopped at 1 as the
-/// cover went to 0 left cloud at any coverage however low, up to the cut,
-/// and sliced it there: vertical walls along the contour of 0.1 %
-/// coverage, seen from below as straight cut edges
-/// (docs/view_below_base.png until 2026-12-05). Beside the soft field's
-/// Gaussian the fringe, where the coverage falls from 0.5 % to 0.14 %, is
-/// about 140 m wide, by a lone parcel and a cluster alike. The clouds it
-/// takes away are specks more than a kilometre from any condensed
-/// parcel: BOMEX's cloud fraction 0.184 -> 0.175 (`cumulus stats`), fair
-/// weather's 0.293 -> 0.292; a fringe up to 2 % (tried from 0 coverage)
-/// took BOMEX's to 0.160.
+/// times the weather) under which the threshold climbs toward the
+/// field's highest value ([`field_max`]), reaching it at [`WEATHER_MAX`]
+/// times [`P_COVERAGE_MIN`], the highest presence at `footprint`'s cut.
+/// The mixed field exceeds 1 over a few percent of the sky, so a
+/// threshold that stopped at 1 made cloud at any coverage up to the cut
+/// and sliced it there in vertical walls (docs/view_below_base.png until
+/// 2026-12-05). The fringe is about 140 m wide beside the soft field's
+/// Gaussian; what it takes away (specks a kilometre from any condensed
+/// parcel) is measured in the README ("What still looks wrong").
 pub const FRINGE_PRESENCE: f32 = 0.005;
 
 /// The cumulus field's threshold at normalised height `eta` under a local
