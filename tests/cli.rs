@@ -1033,3 +1033,59 @@ fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
     );
     assert!(!out.exists());
 }
+
+/// Under a sun below the horizon the picture is exposed for the twilight
+/// (`render.auto_exposure`, on by default): the sky above the clouds is a
+/// dusk blue, not black. With it off, at the day's exposure, it is black
+/// (as every picture of a set sun was before 2026-12-05).
+#[test]
+fn render_exposes_a_twilight_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scenes/fair_weather.toml")).unwrap();
+    let twilight = text.replace("sun_elevation_deg = 28.0", "sun_elevation_deg = -6.0");
+    assert_ne!(twilight, text, "the shipped scene's sun moved");
+    let sky = |extra: &str, name: &str| {
+        let scene = dir.path().join(format!("{name}.toml"));
+        let with = twilight.replacen("[render]\n", &format!("[render]\n{extra}"), 1);
+        std::fs::write(&scene, with).unwrap();
+        let out = dir.path().join(format!("{name}.png"));
+        let o = cumulus(&[
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--time-s",
+            "600",
+            "--backend",
+            "cpu",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        // The top rows: sky above the clouds.
+        let img = image::open(&out).unwrap().to_rgb8();
+        let mut sum = [0.0f64; 3];
+        let top: Vec<_> = img.enumerate_pixels().filter(|(_, y, _)| *y < 8).collect();
+        for (_, _, p) in &top {
+            for (s, v) in sum.iter_mut().zip(p.0) {
+                *s += v as f64 / top.len() as f64;
+            }
+        }
+        sum
+    };
+    let metered = sky("", "metered");
+    let fixed = sky("auto_exposure = false\n", "fixed");
+    assert!(
+        fixed.iter().all(|&c| c < 3.0),
+        "at the day's exposure: {fixed:?}"
+    );
+    // Measured: about (18, 12, 32) of 255; at the day's exposure (0, 0, 0).
+    assert!(metered[2] > 20.0, "metered: {metered:?}");
+    assert!(
+        metered[2] > metered[0] && metered[2] > metered[1],
+        "a dusk blue: {metered:?}"
+    );
+}

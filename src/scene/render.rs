@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::render::camera::Camera;
 use crate::render::cloud_map::CloudMapConfig;
 use crate::render::cpu::density::DensityParams;
+use crate::render::cpu::exposure::auto_exposure_factor;
 use crate::render::cpu::renderer::Quality;
 use crate::render::cpu::sky::{AtmosphereConfig, GroundConfig};
 use crate::render::gpu::{GpuSettings, TsaaSettings};
@@ -88,6 +89,10 @@ pub struct RenderSettings {
     pub max_distance_m: f32,
     /// Exposure before tone mapping (> 0). Default 1.2.
     pub exposure: f32,
+    /// Opens the exposure below a sun 5° high as the ground's light
+    /// fades (`render::cpu::exposure`), so sunsets and twilight are not
+    /// black. Default true; no shipped scene's sun is that low.
+    pub auto_exposure: bool,
     /// Physics seconds simulated before the picture (>= 0). Default 2400.
     pub time_s: f64,
     /// Temporal anti-aliasing on the GPU (CPU pictures average
@@ -143,6 +148,7 @@ impl Default for RenderSettings {
             haze_distance_m: 25_000.0,
             max_distance_m: 40_000.0,
             exposure: 1.2,
+            auto_exposure: true,
             time_s: 2400.0,
             tsaa: true,
             tsaa_blend: 0.1,
@@ -408,7 +414,24 @@ impl RenderSettings {
         }
     }
 
-    /// The quality knobs.
+    /// The factor on `exposure` of `auto_exposure` (1 when off or under a
+    /// sun at least
+    /// [`AUTO_EXPOSURE_FROM_DEG`](crate::render::cpu::exposure::AUTO_EXPOSURE_FROM_DEG) high; below it, under the
+    /// physical sky, the sky's tables are built on the CPU to meter it).
+    pub fn exposure_factor(&self) -> f32 {
+        if !self.auto_exposure {
+            return 1.0;
+        }
+        auto_exposure_factor(
+            &self.atmosphere,
+            self.haze_distance_m,
+            self.sun_elevation_deg,
+            self.sun_azimuth_deg,
+            self.camera_position_m[1],
+        )
+    }
+
+    /// The quality knobs (the exposure metered by [`Self::exposure_factor`]).
     pub fn quality(&self) -> Quality {
         Quality {
             steps: self.steps,
@@ -416,7 +439,7 @@ impl RenderSettings {
             octaves: self.octaves,
             haze_distance_m: self.haze_distance_m,
             max_distance_m: self.max_distance_m,
-            exposure: self.exposure,
+            exposure: self.exposure * self.exposure_factor(),
             sea_wind_mps: self.ground.sea_wind_mps(),
             sea_wind_toward_deg: self.ground.wind_direction_deg,
             sea_time_s: self.time_s as f32,

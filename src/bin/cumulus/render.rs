@@ -25,7 +25,7 @@ pub struct RenderArgs {
     #[arg(long)]
     scene: PathBuf,
     /// Output picture, written atomically: .png (tone-mapped with ACES
-    /// filmic at render.exposure, sRGB) or .exr (OpenEXR, linear radiance,
+    /// filmic at render.exposure, opened below a 5° sun by render.auto_exposure; sRGB) or .exr (OpenEXR, linear radiance,
     /// no tone map). Needed unless --quality-report is given.
     #[arg(long, required_unless_present = "quality_report")]
     out: Option<PathBuf>,
@@ -487,7 +487,8 @@ fn render_endless(
 }
 
 /// Writes a CPU picture: OpenEXR of the linear radiance, or the PNG of its
-/// tone map at `r.exposure`.
+/// tone map at `r.exposure` (metered at a low sun,
+/// `RenderSettings::exposure_factor`).
 fn write_linear(
     out: &Path,
     picture: Option<Picture>,
@@ -498,7 +499,8 @@ fn write_linear(
         let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
         return write_exr(out, r.width, r.height, rgb);
     }
-    let bytes = cumulus::render::cpu::renderer::to_srgb8(linear, r.exposure);
+    let exposure = r.exposure * r.exposure_factor();
+    let bytes = cumulus::render::cpu::renderer::to_srgb8(linear, exposure);
     write_rgb8(out, r.width, r.height, bytes)
 }
 

@@ -8,6 +8,7 @@
 //! non-periodic warp outside the simulated domain (`density::domain_warp`).
 
 pub mod density;
+pub mod exposure;
 pub mod land;
 pub mod light_volume;
 pub mod lighting;

@@ -1,0 +1,140 @@
+//! The exposure of a low sun and of twilight (`render.auto_exposure`):
+//! the PNG pictures' exposure opens as the light on the ground fades
+//! below a sun [`AUTO_EXPOSURE_FROM_DEG`] high, as a camera's incident
+//! light meter would, so a sunset or a twilight sky is a picture, not
+//! black (at the set exposure a sun 6° below the horizon leaves the sky
+//! at about a five-thousandth of its radiance under a sun 30° up). Both
+//! renderers use the number this computes (the GPU's as its `exposure`
+//! uniform): the scene meters, not the frame, so a picture's exposure
+//! does not depend on where the camera looks.
+
+use glam::Vec3;
+
+use super::sky::{AtmosphereConfig, SkyLight, sky_ambient, sun_direction, sun_light_at};
+use super::sky_luts::SkyLuts;
+
+/// The sun's elevation, degrees, at and above which the exposure is
+/// `render.exposure` itself (every shipped scene's sun is higher); below
+/// it, the metered exposure opens ([`auto_exposure_factor`]).
+pub const AUTO_EXPOSURE_FROM_DEG: f32 = 5.0;
+
+/// The fraction of the fall in the ground's illuminance below
+/// [`AUTO_EXPOSURE_FROM_DEG`] that the exposure makes up (in stops). All
+/// of it would show twilight as bright as a low sun's day; a camera and
+/// the eye keep dusk darker than day. Under the default physical sky
+/// the ground's light falls 9.6 stops from a sun 5° up to one 6° below
+/// the horizon; 0.8 opens the exposure 7.7 of them (docs/sky.md).
+pub const AUTO_EXPOSURE_POWER: f32 = 0.8;
+
+/// The most the metered exposure multiplies `render.exposure` by: 2^20,
+/// 20 stops (a sun 10° below the horizon asks for 12.7).
+pub const AUTO_EXPOSURE_MAX: f32 = 1_048_576.0;
+
+/// Rec. 709 luminance of a linear sRGB colour.
+#[inline]
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The illuminance of level ground under the clear sky (its luminance, in
+/// the renderer's radiance units): the sky's mean radiance over the upper
+/// hemisphere times π ([`sky_ambient`]) and the sun's irradiance at
+/// `altitude_m` on the level ([`sun_light_at`]; none below the horizon).
+pub fn ground_illuminance(sky: &SkyLight, altitude_m: f32, sun_dir: Vec3) -> f32 {
+    let sun = luminance(sun_light_at(sky, altitude_m, sun_dir)) * sun_dir.y.max(0.0);
+    std::f32::consts::PI * luminance(sky_ambient(sky, sun_dir)) + sun
+}
+
+/// The factor on `render.exposure` for a sun at `sun_elevation_deg` and
+/// `sun_azimuth_deg` seen from `altitude_m` under `atmosphere`: 1 at and
+/// above [`AUTO_EXPOSURE_FROM_DEG`] (nothing is built), below it
+/// `(E(5°) / E(sun))^`[`AUTO_EXPOSURE_POWER`] of the ground's illuminance
+/// ([`ground_illuminance`]) under the same atmosphere, at most
+/// [`AUTO_EXPOSURE_MAX`]. Under the physical sky this builds the sky's
+/// tables for both suns on the CPU (about 0.2 s on two cores).
+pub fn auto_exposure_factor(
+    atmosphere: &AtmosphereConfig,
+    haze_distance_m: f32,
+    sun_elevation_deg: f32,
+    sun_azimuth_deg: f32,
+    altitude_m: f32,
+) -> f32 {
+    if sun_elevation_deg >= AUTO_EXPOSURE_FROM_DEG {
+        return 1.0;
+    }
+    let sun = sun_direction(sun_elevation_deg, sun_azimuth_deg);
+    let reference = sun_direction(AUTO_EXPOSURE_FROM_DEG, sun_azimuth_deg);
+    let altitude_m = altitude_m.max(0.0);
+    let (lit, metered) = match atmosphere.sky_params() {
+        Some(params) => {
+            let mut luts = SkyLuts::build(params, reference, altitude_m);
+            let lit = ground_illuminance(&physical(&luts, altitude_m), altitude_m, reference);
+            luts.rebuild_sky_view(sun, altitude_m);
+            let metered = ground_illuminance(&physical(&luts, altitude_m), altitude_m, sun);
+            (lit, metered)
+        }
+        None => {
+            let sky = SkyLight::analytic(haze_distance_m);
+            (
+                ground_illuminance(&sky, altitude_m, reference),
+                ground_illuminance(&sky, altitude_m, sun),
+            )
+        }
+    };
+    if metered.is_nan() || metered <= 0.0 {
+        return AUTO_EXPOSURE_MAX;
+    }
+    (lit / metered)
+        .max(1.0)
+        .powf(AUTO_EXPOSURE_POWER)
+        .min(AUTO_EXPOSURE_MAX)
+}
+
+/// The physical model's sky light for `luts`, clear of clouds.
+fn physical(luts: &SkyLuts, altitude_m: f32) -> SkyLight<'_> {
+    SkyLight {
+        luts: Some(luts),
+        aerial_perspective: true,
+        haze_distance_m: 0.0,
+        camera_altitude_m: altitude_m,
+        ground_cloud_light: Vec3::ZERO,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::cpu::sky::SkyModel;
+
+    #[test]
+    fn the_exposure_opens_as_the_sun_goes_down() {
+        for model in [SkyModel::Physical, SkyModel::Analytic] {
+            let atmosphere = AtmosphereConfig {
+                model,
+                ..AtmosphereConfig::default()
+            };
+            let factor = |el: f32| auto_exposure_factor(&atmosphere, 25_000.0, el, 135.0, 100.0);
+            // A day's sun keeps the set exposure.
+            for el in [5.0, 8.0, 30.0, 90.0] {
+                assert_eq!(factor(el), 1.0, "{model:?} at {el}°");
+            }
+            // Below 5° it opens, more the lower the sun.
+            let mut last = 1.0;
+            for el in [4.0, 2.0, 0.0, -3.0, -6.0, -10.0] {
+                let f = factor(el);
+                assert!(
+                    f >= last && f <= AUTO_EXPOSURE_MAX,
+                    "{model:?} at {el}°: {f}"
+                );
+                last = f;
+            }
+            if model == SkyModel::Physical {
+                // Twilight's ground is thousands of times darker than a
+                // low sun's: 6° below the horizon opens the exposure by
+                // more than 2^7 (the analytic sky never darkens that far).
+                assert!(factor(-6.0) > 128.0, "{}", factor(-6.0));
+                assert!(factor(-10.0) > 4.0 * factor(-6.0));
+            }
+        }
+    }
+}
