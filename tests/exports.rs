@@ -71,6 +71,7 @@ fn the_cpu_exr_is_the_linear_radiance_the_png_tone_maps() {
     let exposure = Scene::load(&scene_path("fair_weather"))
         .expect("scene")
         .render
+        .quality()
         .exposure;
     let png_bytes = image::open(&png).expect("png").to_rgb8().into_raw();
     assert_eq!(to_srgb8(&linear, exposure), png_bytes);
@@ -96,6 +97,7 @@ fn the_gpu_exr_is_linear_and_tone_maps_to_the_gpu_png() {
     let exposure = Scene::load(&scene_path("fair_weather"))
         .expect("scene")
         .render
+        .quality()
         .exposure;
     let ours = to_srgb8(&linear, exposure);
     let gpu = image::open(&png).expect("png").to_rgb8().into_raw();

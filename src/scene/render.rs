@@ -414,19 +414,18 @@ impl RenderSettings {
         }
     }
 
-    /// The factor on `exposure` of `auto_exposure` (1 when off or under a
-    /// sun at least
-    /// [`AUTO_EXPOSURE_FROM_DEG`](crate::render::cpu::exposure::AUTO_EXPOSURE_FROM_DEG) high; below it, under the
-    /// physical sky, the sky's tables are built on the CPU to meter it).
+    /// The factor on `exposure` of `auto_exposure`: 1 when off or under a
+    /// sun at least 5° high; below it, metered from the clear sky's light
+    /// on the ground at the camera's altitude
+    /// ([`auto_exposure_factor`]; under the physical sky its tables are
+    /// built on the CPU once per sky).
     pub fn exposure_factor(&self) -> f32 {
         if !self.auto_exposure {
             return 1.0;
         }
         auto_exposure_factor(
             &self.atmosphere,
-            self.haze_distance_m,
             self.sun_elevation_deg,
-            self.sun_azimuth_deg,
             self.camera_position_m[1],
         )
     }

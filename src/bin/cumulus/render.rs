@@ -25,8 +25,9 @@ pub struct RenderArgs {
     #[arg(long)]
     scene: PathBuf,
     /// Output picture, written atomically: .png (tone-mapped with ACES
-    /// filmic at render.exposure, opened below a 5° sun by render.auto_exposure; sRGB) or .exr (OpenEXR, linear radiance,
-    /// no tone map). Needed unless --quality-report is given.
+    /// filmic at render.exposure, opened below a 5° sun by
+    /// render.auto_exposure; sRGB) or .exr (OpenEXR, linear radiance, no
+    /// tone map). Needed unless --quality-report is given.
     #[arg(long, required_unless_present = "quality_report")]
     out: Option<PathBuf>,
     /// Also write the error-against-cost report (render_quality.csv/.png)
@@ -128,6 +129,17 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
     })?;
     let mut picture = None;
+    let r = &scene.render;
+    let factor = r.exposure_factor();
+    if factor != 1.0 && picture_is_png(a.out.as_deref()) {
+        eprintln!(
+            "auto_exposure: the sun {}° high, exposure {} x {:.4} ({:.1} stops)",
+            r.sun_elevation_deg,
+            r.exposure,
+            factor,
+            factor.log2()
+        );
+    }
     if let Some(out) = &a.out {
         check_output_file(out)?;
         picture = Some(Picture::of(out)?);
@@ -484,6 +496,11 @@ fn render_endless(
         out.display()
     );
     Ok(())
+}
+
+/// Whether `out` (if any) is a PNG, which the exposure applies to.
+fn picture_is_png(out: Option<&Path>) -> bool {
+    out.and_then(|o| Picture::of(o).ok()) == Some(Picture::Png)
 }
 
 /// Writes a CPU picture: OpenEXR of the linear radiance, or the PNG of its

@@ -8,9 +8,11 @@
 //! uniform): the scene meters, not the frame, so a picture's exposure
 //! does not depend on where the camera looks.
 
+use std::sync::{Mutex, MutexGuard, OnceLock, PoisonError};
+
 use glam::Vec3;
 
-use super::sky::{AtmosphereConfig, SkyLight, sky_ambient, sun_direction, sun_light_at};
+use super::sky::{AtmosphereConfig, SkyLight, SkyModel, sky_ambient, sun_direction, sun_light_at};
 use super::sky_luts::SkyLuts;
 
 /// The sun's elevation, degrees, at and above which the exposure is
@@ -37,34 +39,78 @@ fn luminance(c: Vec3) -> f32 {
 }
 
 /// The illuminance of level ground under the clear sky (its luminance, in
-/// the renderer's radiance units): the sky's mean radiance over the upper
-/// hemisphere times π ([`sky_ambient`]) and the sun's irradiance at
-/// `altitude_m` on the level ([`sun_light_at`]; none below the horizon).
+/// the renderer's radiance units): the sky's cosine-weighted mean
+/// radiance over the upper hemisphere times π ([`sky_ambient`]) and the
+/// sun's irradiance at `altitude_m` on the level ([`sun_light_at`]; none
+/// once the sun is below the level, as a level surface sees it).
 pub fn ground_illuminance(sky: &SkyLight, altitude_m: f32, sun_dir: Vec3) -> f32 {
     let sun = luminance(sun_light_at(sky, altitude_m, sun_dir)) * sun_dir.y.max(0.0);
     std::f32::consts::PI * luminance(sky_ambient(sky, sun_dir)) + sun
 }
 
-/// The factor on `render.exposure` for a sun at `sun_elevation_deg` and
-/// `sun_azimuth_deg` seen from `altitude_m` under `atmosphere`: 1 at and
-/// above [`AUTO_EXPOSURE_FROM_DEG`] (nothing is built), below it
+/// The factor on `render.exposure` for a sun at `sun_elevation_deg` seen
+/// from `altitude_m` under `atmosphere`: 1 at and above
+/// [`AUTO_EXPOSURE_FROM_DEG`] (nothing is built), below it
 /// `(E(5°) / E(sun))^`[`AUTO_EXPOSURE_POWER`] of the ground's illuminance
 /// ([`ground_illuminance`]) under the same atmosphere, at most
-/// [`AUTO_EXPOSURE_MAX`]. Under the physical sky this builds the sky's
-/// tables for both suns on the CPU (about 0.2 s on two cores).
+/// [`AUTO_EXPOSURE_MAX`]. The sun's azimuth changes neither term (the
+/// sky-ambient table averages over it). Under the physical sky this
+/// builds the sky's tables for both suns on the CPU (about 0.13 s on two
+/// cores); the last [`METERED_KEPT`] results are kept, so a caller that
+/// asks again for the same sky (the CLI, a panel moving another slider)
+/// pays it once.
 pub fn auto_exposure_factor(
     atmosphere: &AtmosphereConfig,
-    haze_distance_m: f32,
     sun_elevation_deg: f32,
-    sun_azimuth_deg: f32,
     altitude_m: f32,
 ) -> f32 {
     if sun_elevation_deg >= AUTO_EXPOSURE_FROM_DEG {
         return 1.0;
     }
-    let sun = sun_direction(sun_elevation_deg, sun_azimuth_deg);
-    let reference = sun_direction(AUTO_EXPOSURE_FROM_DEG, sun_azimuth_deg);
     let altitude_m = altitude_m.max(0.0);
+    let key = MeterKey {
+        model: atmosphere.model,
+        aerosol_optical_depth: atmosphere.aerosol_optical_depth.to_bits(),
+        sun_elevation_deg: sun_elevation_deg.to_bits(),
+        altitude_m: altitude_m.to_bits(),
+    };
+    let kept = METERED.get_or_init(|| Mutex::new(Vec::new()));
+    if let Some(&(_, f)) = lock(kept).iter().find(|(k, _)| *k == key) {
+        return f;
+    }
+    let f = meter(atmosphere, sun_elevation_deg, altitude_m);
+    let mut kept = lock(kept);
+    if kept.len() >= METERED_KEPT {
+        kept.remove(0);
+    }
+    kept.push((key, f));
+    f
+}
+
+/// How many metered exposures [`auto_exposure_factor`] keeps.
+pub const METERED_KEPT: usize = 8;
+
+/// What the metered exposure depends on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct MeterKey {
+    model: SkyModel,
+    aerosol_optical_depth: u32,
+    sun_elevation_deg: u32,
+    altitude_m: u32,
+}
+
+static METERED: OnceLock<Mutex<Vec<(MeterKey, f32)>>> = OnceLock::new();
+
+/// The kept results, also after a panic elsewhere left the lock poisoned
+/// (they are plain numbers, never half written).
+fn lock(kept: &Mutex<Vec<(MeterKey, f32)>>) -> MutexGuard<'_, Vec<(MeterKey, f32)>> {
+    kept.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// [`auto_exposure_factor`] below [`AUTO_EXPOSURE_FROM_DEG`], uncached.
+fn meter(atmosphere: &AtmosphereConfig, sun_elevation_deg: f32, altitude_m: f32) -> f32 {
+    let sun = sun_direction(sun_elevation_deg, 0.0);
+    let reference = sun_direction(AUTO_EXPOSURE_FROM_DEG, 0.0);
     let (lit, metered) = match atmosphere.sky_params() {
         Some(params) => {
             let mut luts = SkyLuts::build(params, reference, altitude_m);
@@ -74,7 +120,8 @@ pub fn auto_exposure_factor(
             (lit, metered)
         }
         None => {
-            let sky = SkyLight::analytic(haze_distance_m);
+            // The analytic sky's light has no haze in it.
+            let sky = SkyLight::analytic(1.0);
             (
                 ground_illuminance(&sky, altitude_m, reference),
                 ground_illuminance(&sky, altitude_m, sun),
@@ -104,7 +151,6 @@ fn physical(luts: &SkyLuts, altitude_m: f32) -> SkyLight<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::cpu::sky::SkyModel;
 
     #[test]
     fn the_exposure_opens_as_the_sun_goes_down() {
@@ -113,7 +159,7 @@ mod tests {
                 model,
                 ..AtmosphereConfig::default()
             };
-            let factor = |el: f32| auto_exposure_factor(&atmosphere, 25_000.0, el, 135.0, 100.0);
+            let factor = |el: f32| auto_exposure_factor(&atmosphere, el, 100.0);
             // A day's sun keeps the set exposure.
             for el in [5.0, 8.0, 30.0, 90.0] {
                 assert_eq!(factor(el), 1.0, "{model:?} at {el}°");
@@ -132,8 +178,13 @@ mod tests {
                 // Twilight's ground is thousands of times darker than a
                 // low sun's: 6° below the horizon opens the exposure by
                 // more than 2^7 (the analytic sky never darkens that far).
+                // Measured: 2^7.7 and 2^12.7; the light was metered (not
+                // the cap of a sky with no light at all).
                 assert!(factor(-6.0) > 128.0, "{}", factor(-6.0));
                 assert!(factor(-10.0) > 4.0 * factor(-6.0));
+                assert!(factor(-10.0) < AUTO_EXPOSURE_MAX / 16.0);
+                // Asked again, the kept result.
+                assert_eq!(factor(-6.0), meter(&atmosphere, -6.0, 100.0));
             }
         }
     }
