@@ -46,6 +46,10 @@ pub struct PanelState {
     pub physical_sky: bool,
     /// The physical sky's aerosol optical depth, 0..=3.
     pub aerosol_optical_depth: f32,
+    /// Exposure before the tone map (`[render] exposure`).
+    pub exposure: f32,
+    /// The exposure opened below a 5° sun (`[render] auto_exposure`).
+    pub auto_exposure: bool,
 }
 
 impl PanelState {
@@ -70,6 +74,8 @@ impl PanelState {
             fine_detail: r.fine_detail,
             physical_sky: r.atmosphere.model == SkyModel::Physical,
             aerosol_optical_depth: r.atmosphere.aerosol_optical_depth,
+            exposure: r.exposure,
+            auto_exposure: r.auto_exposure,
         }
     }
 
@@ -96,6 +102,8 @@ impl PanelState {
             SkyModel::Analytic
         };
         r.atmosphere.aerosol_optical_depth = self.aerosol_optical_depth;
+        r.exposure = self.exposure;
+        r.auto_exposure = self.auto_exposure;
         scene.physics.parcels = self.parcels;
         scene.physics.wind.speed_mps = self.wind_speed_mps;
         scene.physics.wind.direction_deg = self.wind_direction_deg;

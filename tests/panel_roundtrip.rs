@@ -27,6 +27,8 @@ fn roundtrip(name: &str) {
     panel.fine_detail = !panel.fine_detail;
     panel.physical_sky = !panel.physical_sky;
     panel.aerosol_optical_depth = 0.42;
+    panel.exposure = 2.5;
+    panel.auto_exposure = !panel.auto_exposure;
     panel.apply(&mut scene);
 
     // Saved elsewhere: a sounding path must still find its file.

@@ -127,7 +127,7 @@ pub fn panel(
         ch |= unit_slider(
             ui,
             &mut p.sun_elevation_deg,
-            -5.0..=90.0,
+            -10.0..=90.0,
             "sun elevation, °",
         );
         ch |= unit_slider(
@@ -145,6 +145,16 @@ pub fn panel(
             0.0..=1.5,
             "aerosol optical depth (haze)",
         );
+        ch |= ui
+            .add(
+                egui::Slider::new(&mut p.exposure, 0.05..=20.0)
+                    .logarithmic(true)
+                    .text("exposure"),
+            )
+            .changed();
+        ch |= ui
+            .checkbox(&mut p.auto_exposure, "open the exposure below a 5° sun")
+            .changed();
         ui.separator();
         ui.label("Quality (off = the pass or code is not built)");
         ch |= ui
