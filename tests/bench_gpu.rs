@@ -397,14 +397,14 @@ fn the_volume_renderer_matches_its_cpu_twin_on_a_blend() {
     let frame = p.frame(r, r.quality());
     let cpu = to_srgb8(
         &render_volume(w, h, &frame, &params, &stack, 1),
-        r.quality().exposure,
+        frame.quality.exposure,
     );
     let (mean, within) = agreement(&gpu, &cpu);
     let mut empty = stack.clone();
     empty.texels.fill(0);
     let clear = to_srgb8(
         &render_volume(w, h, &frame, &params, &empty, 1),
-        r.quality().exposure,
+        frame.quality.exposure,
     );
     let cloudy = mask(&cpu, &clear).iter().filter(|x| **x).count();
     eprintln!(

@@ -970,6 +970,32 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
     );
 }
 
+/// `render`s `scene` into `out` as a 48x36 CPU picture, with `extra`
+/// flags; asserts success and reads the picture back.
+fn render_small_cpu(
+    scene: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> image::RgbImage {
+    let mut args = vec![
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "48",
+        "--height",
+        "36",
+        "--backend",
+        "cpu",
+    ];
+    args.extend_from_slice(extra);
+    let o = cumulus(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    image::open(out).unwrap().to_rgb8()
+}
+
 /// `render --single-scattering`: the sun's once-scattered light alone, so
 /// where no cloud is the picture is black (the sky behind is left out);
 /// refused with a clear error for what it does not cover (the spheroid
@@ -979,26 +1005,12 @@ fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
     let dir = tempfile::tempdir().unwrap();
     let scene = root().join("scenes/fair_weather.toml");
     let render = |name: &str, single: bool| {
-        let out = dir.path().join(name);
-        let mut args = vec![
-            "render",
-            "--scene",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--width",
-            "48",
-            "--height",
-            "36",
-            "--backend",
-            "cpu",
-        ];
-        if single {
-            args.push("--single-scattering");
-        }
-        let o = cumulus(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        image::open(out).unwrap().to_rgb8()
+        let extra: &[&str] = if single {
+            &["--single-scattering"]
+        } else {
+            &[]
+        };
+        render_small_cpu(&scene, &dir.path().join(name), extra)
     };
     let black = |img: &image::RgbImage| img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
     let (full, single) = (render("full.png", false), render("single.png", true));
@@ -1048,25 +1060,12 @@ fn render_exposes_a_twilight_sky() {
         let scene = dir.path().join(format!("{name}.toml"));
         let with = twilight.replacen("[render]\n", &format!("[render]\n{extra}"), 1);
         std::fs::write(&scene, with).unwrap();
-        let out = dir.path().join(format!("{name}.png"));
-        let o = cumulus(&[
-            "render",
-            "--scene",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--width",
-            "48",
-            "--height",
-            "36",
-            "--time-s",
-            "600",
-            "--backend",
-            "cpu",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        let img = render_small_cpu(
+            &scene,
+            &dir.path().join(format!("{name}.png")),
+            &["--time-s", "600"],
+        );
         // The top rows: sky above the clouds.
-        let img = image::open(&out).unwrap().to_rgb8();
         let mut sum = [0.0f64; 3];
         let top: Vec<_> = img.enumerate_pixels().filter(|(_, y, _)| *y < 8).collect();
         for (_, _, p) in &top {

@@ -504,8 +504,8 @@ fn picture_is_png(out: Option<&Path>) -> bool {
 }
 
 /// Writes a CPU picture: OpenEXR of the linear radiance, or the PNG of its
-/// tone map at `r.exposure` (metered at a low sun,
-/// `RenderSettings::exposure_factor`).
+/// tone map at the quality's exposure (`r.exposure`, metered at a low sun
+/// by `RenderSettings::exposure_factor`).
 fn write_linear(
     out: &Path,
     picture: Option<Picture>,
@@ -516,7 +516,7 @@ fn write_linear(
         let rgb = linear.iter().flat_map(|c| c.to_array()).collect();
         return write_exr(out, r.width, r.height, rgb);
     }
-    let exposure = r.exposure * r.exposure_factor();
+    let exposure = r.quality().exposure;
     let bytes = cumulus::render::cpu::renderer::to_srgb8(linear, exposure);
     write_rgb8(out, r.width, r.height, bytes)
 }
