@@ -134,7 +134,7 @@ struct Frame {
     screen: vec4f,       // width, height (px), depth of an empty pixel (1, or 0 reversed), 1 if the depth read is stored flipped
     sun_dir: vec4f,      // xyz, haze distance (m)
     sun_light: vec4f,    // sun colour * SUN_INTENSITY, max distance (m)
-    exposure: vec4f,     // exposure before the tone map, 1 when the cloud layer carries the sea's mirrored clouds (else 0), the share of the ground under cloud, unused
+    exposure: vec4f,     // exposure before the tone map, 1 when the cloud layer carries the sea's mirrored clouds (else 0), the share of the ground under cloud, the sun glare's strength (render.sun_glare)
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend

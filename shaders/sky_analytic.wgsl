@@ -61,3 +61,10 @@ fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {
     }
     return vec3f(0.0);
 }
+
+// The flat disk's radiance over its solid angle (the CPU's
+// `sun_disk_irradiance`).
+fn sun_disk_irradiance(sun_dir: vec3f) -> vec3f {
+    return sun_color(sun_dir) * (60.0 * 2.0 * PI * (1.0 - SUN_DISK_COS));
+}
+

@@ -62,3 +62,9 @@ fn sun_disk(dir: vec3f, sun_dir: vec3f) -> vec3f {
         radians(sky_params.sun_angular_radius_deg),
     );
 }
+
+// The sun disk's irradiance at the camera (the CPU's `sun_disk_irradiance`).
+fn sun_disk_irradiance(sun_dir: vec3f) -> vec3f {
+    return sun_light_at(frame.cam_pos.y, sun_dir);
+}
+

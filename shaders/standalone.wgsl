@@ -19,3 +19,10 @@ fn hazed_clouds(light: vec3f, transmittance: f32, depth_weighted: f32, dir: vec3
     let a = aerial(dir, distance, sun_dir);
     return vec4f(light * a.transmittance + a.inscatter * opacity, opacity);
 }
+
+// The stand-alone passes have no cloud layer to read the sun's visibility
+// from, and draw no glare (composite.wgsl's glare_at is not called): the
+// sky counts as hidden.
+fn terrain_hides(px: vec2i) -> bool {
+    return true;
+}

@@ -50,6 +50,8 @@ pub struct PanelState {
     pub exposure: f32,
     /// The exposure opened below a 5° sun (`[render] auto_exposure`).
     pub auto_exposure: bool,
+    /// The sun's glare, 0 off (`[render] sun_glare`).
+    pub sun_glare: f32,
 }
 
 impl PanelState {
@@ -76,6 +78,7 @@ impl PanelState {
             aerosol_optical_depth: r.atmosphere.aerosol_optical_depth,
             exposure: r.exposure,
             auto_exposure: r.auto_exposure,
+            sun_glare: r.sun_glare,
         }
     }
 
@@ -104,6 +107,7 @@ impl PanelState {
         r.atmosphere.aerosol_optical_depth = self.aerosol_optical_depth;
         r.exposure = self.exposure;
         r.auto_exposure = self.auto_exposure;
+        r.sun_glare = self.sun_glare;
         scene.physics.parcels = self.parcels;
         scene.physics.wind.speed_mps = self.wind_speed_mps;
         scene.physics.wind.direction_deg = self.wind_direction_deg;

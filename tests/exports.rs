@@ -30,7 +30,10 @@ fn stderr(o: &Output) -> String {
 }
 
 fn render(out: &Path, extra: &[&str]) -> Output {
-    let scene = scene_path("fair_weather");
+    render_scene(&scene_path("fair_weather"), out, extra)
+}
+
+fn render_scene(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "render",
         "--scene",
@@ -55,17 +58,40 @@ fn read_exr(path: &Path) -> (u32, u32, Vec<Vec3>) {
     (w, h, px)
 }
 
+/// Fair weather with `render.sun_glare = 0`, written into `dir`: the PNG
+/// without the glare the EXR never has.
+fn fair_weather_without_glare(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(scene_path("fair_weather")).expect("scene");
+    assert!(text.contains("\n[render]\n"));
+    let path = dir.join("no_glare.toml");
+    std::fs::write(
+        &path,
+        text.replacen("\n[render]\n", "\n[render]\nsun_glare = 0.0\n", 1),
+    )
+    .expect("write");
+    path
+}
+
 /// The CPU's `.exr` holds the very linear radiance its `.png` tone-maps:
-/// tone-mapping the EXR's floats gives the PNG's bytes exactly (an EXR of
-/// display values, tone-mapped once more, would come out darker).
+/// with the sun's glare off, tone-mapping the EXR's floats gives the PNG's
+/// bytes exactly (an EXR of display values, tone-mapped once more, would
+/// come out darker). With the glare on (the default) the PNG only gains
+/// light: the glare is added to the picture, never to the EXR.
 #[test]
 fn the_cpu_exr_is_the_linear_radiance_the_png_tone_maps() {
     let dir = tempfile::tempdir().expect("dir");
-    let (png, exr) = (dir.path().join("a.png"), dir.path().join("a.exr"));
-    for out in [&png, &exr] {
-        let o = render(out, &["--backend", "cpu"]);
+    let plain = fair_weather_without_glare(dir.path());
+    let (png, exr, glare) = (
+        dir.path().join("a.png"),
+        dir.path().join("a.exr"),
+        dir.path().join("glare.png"),
+    );
+    for (scene, out) in [(&plain, &png), (&plain, &exr)] {
+        let o = render_scene(scene, out, &["--backend", "cpu"]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
+    let o = render(&glare, &["--backend", "cpu"]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let (w, h, linear) = read_exr(&exr);
     assert_eq!((w, h), (64, 48));
     let exposure = Scene::load(&scene_path("fair_weather"))
@@ -75,11 +101,13 @@ fn the_cpu_exr_is_the_linear_radiance_the_png_tone_maps() {
         .exposure;
     let png_bytes = image::open(&png).expect("png").to_rgb8().into_raw();
     assert_eq!(to_srgb8(&linear, exposure), png_bytes);
+    let glare_bytes = image::open(&glare).expect("png").to_rgb8().into_raw();
+    assert!(glare_bytes.iter().zip(&png_bytes).all(|(g, p)| g >= p));
 }
 
 /// The GPU's `.exr` comes from a float target, which the composite pass
 /// leaves linear: tone-mapping its floats on the CPU gives the GPU's own
-/// `.png` of the same frames within two levels (the PNG's target encodes
+/// `.png` of the same frames (the sun's glare off) within two levels (the PNG's target encodes
 /// in 8 bits and the GPU's arithmetic differs in the last bits).
 #[test]
 fn the_gpu_exr_is_linear_and_tone_maps_to_the_gpu_png() {
@@ -88,8 +116,9 @@ fn the_gpu_exr_is_linear_and_tone_maps_to_the_gpu_png() {
     }
     let dir = tempfile::tempdir().expect("dir");
     let (png, exr) = (dir.path().join("g.png"), dir.path().join("g.exr"));
+    let plain = fair_weather_without_glare(dir.path());
     for out in [&png, &exr] {
-        let o = render(out, &["--backend", "gpu", "--frames", "2"]);
+        let o = render_scene(&plain, out, &["--backend", "gpu", "--frames", "2"]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
     let (w, h, linear) = read_exr(&exr);

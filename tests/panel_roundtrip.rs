@@ -29,6 +29,7 @@ fn roundtrip(name: &str) {
     panel.aerosol_optical_depth = 0.42;
     panel.exposure = 2.5;
     panel.auto_exposure = !panel.auto_exposure;
+    panel.sun_glare = 0.35;
     panel.apply(&mut scene);
 
     // Saved elsewhere: a sounding path must still find its file.

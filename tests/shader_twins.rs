@@ -13,7 +13,7 @@ use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
 use cumulus::render::cpu::{
-    density, land, light_volume, lighting, renderer, sea, sky, sky_luts, waves,
+    density, glare, land, light_volume, lighting, renderer, sea, sky, sky_luts, waves,
 };
 use cumulus::render::gpu::light_volume_pass::{self, DiffusionGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
@@ -37,6 +37,9 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("lerp", "glam's Vec3::lerp"),
     // The composite's background: sky_radiance + sun_disk on the CPU.
     ("sky_background", "background_radiance per pixel"),
+    // The composite's glare at one pixel: add_sun_glare's loop over the
+    // image on the CPU (glare_source, sun_glare).
+    ("glare_at", "add_sun_glare per pixel"),
     // Integer wrap of texel indices (rem_euclid on the CPU).
     ("wrap_i", "i64::rem_euclid on the CPU"),
     // The light volume's grid: DiffusionGrid's methods index, cell, centre.
@@ -55,6 +58,10 @@ const GPU_ONLY: &[(&str, &str)] = &[
 fn rust_constants() -> Vec<(&'static str, f64)> {
     vec![
         ("PI", std::f32::consts::PI as f64),
+        ("GLARE_CORE", glare::GLARE_CORE as f64),
+        ("GLARE_MIN_DEG", glare::GLARE_MIN_DEG as f64),
+        ("GLARE_TAPS", glare::GLARE_TAPS as f64),
+        ("GLARE_TAP_REACH", glare::GLARE_TAP_REACH as f64),
         ("SPHEROID_KAPPA", spheroids::SPHEROID_KAPPA as f64),
         ("MAX_CANDIDATES", spheroids::MAX_CANDIDATES as f64),
         ("FBM_OCTAVES", spheroids::FBM_OCTAVES as f64),

@@ -155,6 +155,7 @@ pub fn panel(
         ch |= ui
             .checkbox(&mut p.auto_exposure, "open the exposure below a 5° sun")
             .changed();
+        ch |= unit_slider(ui, &mut p.sun_glare, 0.0..=3.0, "sun glare (0: off)");
         ui.separator();
         ui.label("Quality (off = the pass or code is not built)");
         ch |= ui

@@ -93,6 +93,11 @@ pub struct RenderSettings {
     /// fades (`render::cpu::exposure`), so sunsets and twilight are not
     /// black. Default true; no shipped scene's sun is that low.
     pub auto_exposure: bool,
+    /// The sun's glare in the tone-mapped pictures (`render::cpu::glare`):
+    /// the light a lens and an eye scatter around the sun disk, 1 the
+    /// CIE's spread for the eye near the sun, 0 none (0..=10). Default 1.
+    /// The linear outputs (OpenEXR, an HDR target) never have it.
+    pub sun_glare: f32,
     /// Physics seconds simulated before the picture (>= 0). Default 2400.
     pub time_s: f64,
     /// Temporal anti-aliasing on the GPU (CPU pictures average
@@ -149,6 +154,7 @@ impl Default for RenderSettings {
             max_distance_m: 40_000.0,
             exposure: 1.2,
             auto_exposure: true,
+            sun_glare: 1.0,
             time_s: 2400.0,
             tsaa: true,
             tsaa_blend: 0.1,
@@ -289,6 +295,7 @@ impl RenderSettings {
                 "1..=1e7 m",
             ),
             range("render.exposure", f(r.exposure), 1e-3, 1e3, "0.001..=1000"),
+            range("render.sun_glare", f(r.sun_glare), 0.0, 10.0, "0..=10"),
             range("render.time_s", r.time_s, 0.0, 1e7, "0..=1e7 s"),
             range("render.tsaa_blend", f(r.tsaa_blend), 1e-3, 1.0, "0.001..=1"),
             Check::new(
@@ -439,6 +446,7 @@ impl RenderSettings {
             haze_distance_m: self.haze_distance_m,
             max_distance_m: self.max_distance_m,
             exposure: self.exposure * self.exposure_factor(),
+            sun_glare: self.sun_glare,
             sea_wind_mps: self.ground.sea_wind_mps(),
             sea_wind_toward_deg: self.ground.wind_direction_deg,
             sea_time_s: self.time_s as f32,

@@ -104,7 +104,7 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::renderer::{Quality, render_still};
+    use cumulus::render::cpu::renderer::{Quality, add_sun_glare, render_still};
     use cumulus::report::render_quality;
 
     let flags = [
@@ -252,7 +252,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let Some(out) = &a.out else { return Ok(()) };
     let start = std::time::Instant::now();
-    let linear = render_still(r.width, r.height, &frame, r.cpu_offsets);
+    let mut linear = render_still(r.width, r.height, &frame, r.cpu_offsets);
+    if picture != Some(Picture::Exr) {
+        // The tone-mapped picture gets the sun's glare (`still_srgb8`; the
+        // GPU's composite adds it the same way); the linear OpenEXR does
+        // not.
+        add_sun_glare(&mut linear, r.width, r.height, &frame, r.cpu_offsets);
+    }
     let elapsed = start.elapsed();
 
     write_linear(out, picture, r, &linear)?;

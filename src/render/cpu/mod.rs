@@ -9,6 +9,7 @@
 
 pub mod density;
 pub mod exposure;
+pub mod glare;
 pub mod land;
 pub mod light_volume;
 pub mod lighting;

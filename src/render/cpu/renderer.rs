@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
+use super::glare::{add_glare, sun_visibility};
 use super::land::{flat_ground_albedo, terrain_albedo};
 use super::light_volume::LightVolume;
 use super::lighting::{
@@ -18,7 +19,7 @@ use super::lighting::{
 use super::sea::sea_reflection_change;
 use super::sky::{
     AtmosphereConfig, SkyLight, aerial, background_radiance, ground_cloud_light, ground_up,
-    sky_ambient, sun_direction, sun_light_at,
+    sky_ambient, sun_direction, sun_disk_irradiance, sun_light_at,
 };
 use super::sky_luts::SkyLuts;
 pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
@@ -44,6 +45,9 @@ pub struct Quality {
     pub max_distance_m: f32,
     /// Exposure multiplier before tone mapping.
     pub exposure: f32,
+    /// The strength of the sun's glare in tone-mapped pictures
+    /// (`render.sun_glare`; [`super::glare`]): 1 the CIE's eye, 0 none.
+    pub sun_glare: f32,
     /// The sea below the horizon with this wind speed, m/s (`None`:
     /// land; [`super::sky::background_radiance`]).
     pub sea_wind_mps: Option<f32>,
@@ -499,37 +503,94 @@ fn render_marches(
     jittered: bool,
     pick: impl Fn(RaySample) -> Vec4 + Sync,
 ) -> Vec<Vec4> {
-    let n = frames.max(1);
     let w = width as usize;
-    let spread = fr.view.pixel_spread(width, height);
     let mut out = vec![Vec4::ZERO; w * height as usize];
     out.par_chunks_mut(w.max(1))
         .enumerate()
         .for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
-                let d0 = pixel_dither(x as u32, y as u32);
-                let mut sum = Vec4::ZERO;
-                for k in 0..n {
-                    // Frame k's dither offset, past the jitter's cycle too
-                    // (the same as `jitter(k)`'s within it), so that more
-                    // than JITTER_CYCLE stills' marches are all distinct.
-                    let [jx, jy] = if jittered {
-                        let [jx, jy, _] = jitter(k);
-                        [jx, jy]
-                    } else {
-                        [0.0, 0.0]
-                    };
-                    let offset = frame_offset(k);
-                    let dir =
-                        fr.view
-                            .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);
-                    let d = (d0 + offset).fract();
-                    sum += pick(march_ray(fr.view.eye(), dir, d, spread, fr));
-                }
-                *px = sum / n as f32;
+                *px = pixel_marches(
+                    x as u32, y as u32, width, height, fr, frames, jittered, &pick,
+                );
             }
         });
     out
+}
+
+/// Pixel `(x, y)`'s mean over `frames` marches of `pick` of the ray's
+/// sample ([`render_marches`], one pixel).
+#[allow(clippy::too_many_arguments)]
+fn pixel_marches(
+    x: u32,
+    y: u32,
+    width: u32,
+    height: u32,
+    fr: &Frame,
+    frames: u32,
+    jittered: bool,
+    pick: &impl Fn(RaySample) -> Vec4,
+) -> Vec4 {
+    let n = frames.max(1);
+    let spread = fr.view.pixel_spread(width, height);
+    let d0 = pixel_dither(x, y);
+    let mut sum = Vec4::ZERO;
+    for k in 0..n {
+        // Frame k's dither offset, past the jitter's cycle too (the same
+        // as `jitter(k)`'s within it), so that more than JITTER_CYCLE
+        // stills' marches are all distinct.
+        let [jx, jy] = if jittered {
+            let [jx, jy, _] = jitter(k);
+            [jx, jy]
+        } else {
+            [0.0, 0.0]
+        };
+        let offset = frame_offset(k);
+        let dir = fr
+            .view
+            .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);
+        let d = (d0 + offset).fract();
+        sum += pick(march_ray(fr.view.eye(), dir, d, spread, fr));
+    }
+    sum / n as f32
+}
+
+/// The source of the sun's glare in a `width x height` still of `fr`
+/// made of `offsets` marches a pixel ([`render_still`]): the sun disk's
+/// irradiance at the camera ([`sun_disk_irradiance`]) times its
+/// visibility through the clouds ([`sun_visibility`]: the transmittance
+/// of the still's own marches at the taps across the disk, 0 where the
+/// terrain hides it) times `render.sun_glare`; zero when that is 0, and
+/// for single scattering.
+pub fn glare_source(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec3 {
+    let q = &fr.quality;
+    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let irradiance = sun_disk_irradiance(&fr.sky_light(), sun_dir);
+    if q.sun_glare <= 0.0 || q.single_scattering || irradiance == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let eye = fr.view.eye();
+    let visibility = sun_visibility(&fr.view, width, height, sun_dir, |x, y| {
+        let centre = fr
+            .view
+            .camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
+        let hidden = fr
+            .terrain
+            .is_some_and(|h| h.intersect(eye, centre, q.max_distance_m).is_some());
+        if hidden {
+            return 0.0;
+        }
+        let pick = |s: RaySample| Vec4::splat(s.transmittance);
+        pixel_marches(x, y, width, height, fr, offsets, offsets > 1, &pick).x
+    });
+    irradiance * visibility * q.sun_glare
+}
+
+/// Adds the sun's glare ([`glare_source`], [`super::glare`]) to a still
+/// of `fr` made of `offsets` marches a pixel, before its tone map.
+pub fn add_sun_glare(linear: &mut [Vec3], width: u32, height: u32, fr: &Frame, offsets: u32) {
+    let source = glare_source(width, height, fr, offsets);
+    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    add_glare(linear, &fr.view, width, height, sun_dir, source);
 }
 
 /// The clouds alone, without the sky or terrain behind them: per pixel
@@ -559,7 +620,7 @@ pub fn render_linear(width: u32, height: u32, fr: &Frame) -> Vec<Vec3> {
 }
 
 /// A `width x height` image of `samples x samples` rays per pixel
-/// (a box filter over a finer image), as sRGB8: the reference that TSAA's
+/// (a box filter over a finer image), with the sun's glare, as sRGB8: the reference that TSAA's
 /// jittered frames converge to, for the benchmark's error and the tests.
 pub fn supersampled_srgb8(width: u32, height: u32, samples: u32, fr: &Frame) -> Vec<u8> {
     let s = samples.max(1);
@@ -571,7 +632,21 @@ pub fn supersampled_srgb8(width: u32, height: u32, samples: u32, fr: &Frame) -> 
                 fine[(y * width * s + x) as usize] / (s * s) as f32;
         }
     }
+    // The glare's source read on the fine image, its spread at the
+    // pixels' centres, as the GPU's composite evaluates it.
+    let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let source = glare_source(width * s, height * s, fr, 1);
+    add_glare(&mut out, &fr.view, width, height, sun_dir, source);
     to_srgb8(&out, fr.quality.exposure)
+}
+
+/// The PNG picture of a still (`cumulus render --backend cpu`):
+/// [`render_still`] of `offsets` marches a pixel, the sun's glare added
+/// ([`add_sun_glare`]), tone-mapped and sRGB-encoded ([`to_srgb8`]).
+pub fn still_srgb8(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<u8> {
+    let mut linear = render_still(width, height, fr, offsets);
+    add_sun_glare(&mut linear, width, height, fr, offsets);
+    to_srgb8(&linear, fr.quality.exposure)
 }
 
 #[cfg(test)]

@@ -327,6 +327,19 @@ pub fn sun_disk(sky: &SkyLight, dir: Vec3, sun_dir: Vec3) -> Vec3 {
     }
 }
 
+/// The sun disk's irradiance at the camera, its [`sun_disk`] radiance
+/// integrated over the disk (`sun_disk_irradiance` in WGSL): physical,
+/// the sun's light at the camera's altitude; analytic, its flat disk of
+/// 60 times the sun's colour over the disk's solid angle. The source of
+/// the sun's glare ([`super::glare`]).
+#[inline]
+pub fn sun_disk_irradiance(sky: &SkyLight, sun_dir: Vec3) -> Vec3 {
+    match sky.luts {
+        Some(_) => sun_light_at(sky, sky.camera_altitude_m, sun_dir),
+        None => sun_color(sun_dir) * (60.0 * 2.0 * PI * (1.0 - SUN_DISK_COS)),
+    }
+}
+
 /// Unit vector toward a sun at `elevation_deg` above the horizon and
 /// `azimuth_deg` clockwise from north (+z).
 pub fn sun_direction(elevation_deg: f32, azimuth_deg: f32) -> Vec3 {

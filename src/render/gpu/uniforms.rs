@@ -97,7 +97,7 @@ impl FrameUniforms {
                 q.exposure,
                 if i.sea_in_layer { 1.0 } else { 0.0 },
                 i.cloud_cover,
-                0.0,
+                q.sun_glare,
             ],
             band: [
                 d.band_bottom_m,
