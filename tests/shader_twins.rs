@@ -31,6 +31,9 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("view_depth", "no depth buffer on the CPU"),
     // Tone map plus sRGB encode of the composite; the CPU's to_srgb8.
     ("display", "the CPU's to_srgb8"),
+    // An sRGB target encodes the composite's dithered value again in
+    // hardware; the CPU rounds the encoded value itself (to_srgb8).
+    ("srgb_decode", "to_srgb8 rounds the encoded value"),
     // glam's Vec3::normalize_or on the CPU.
     ("normalize_or", "glam's Vec3::normalize_or"),
     // glam's Vec3::lerp (the sky tables' bilinear, Lut2::sample_texels).

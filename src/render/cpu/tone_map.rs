@@ -62,21 +62,115 @@ pub fn srgb_encode(x: f32) -> f32 {
     }
 }
 
-/// Tone map ([`tone_map`]) and sRGB-encode to 8 bits.
+/// Tone map ([`tone_map`]), sRGB-encode and dither ([`dither_encoded`]
+/// by [`output_dither`] of the pixel's row-major index) to 8 bits.
 pub fn to_srgb8(linear: &[Vec3], exposure: f32) -> Vec<u8> {
-    let enc = |x: f32| (srgb_encode(x).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
     linear
         .iter()
-        .flat_map(|&c| {
+        .enumerate()
+        .flat_map(|(i, &c)| {
+            let noise = output_dither(i as u32);
+            let enc = |x: f32| {
+                let e = dither_encoded(srgb_encode(x).clamp(0.0, 1.0), noise);
+                (e * 255.0 + 0.5).floor().clamp(0.0, 255.0) as u8
+            };
             let m = tone_map(c, exposure);
             [enc(m.x), enc(m.y), enc(m.z)]
         })
         .collect()
 }
 
+/// A 32-bit integer hash (Chris Wellons' "lowbias32"; `hash_u32` in
+/// WGSL): every input bit changes about half the output bits.
+#[inline]
+pub fn hash_u32(x: u32) -> u32 {
+    let mut x = x;
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// The 8-bit output's dither at pixel `index` (row-major; `output_dither`
+/// in WGSL, which takes `y · width + x`), in 8-bit levels, `(-1, 1)`: the
+/// sum of two uniform values from [`hash_u32`] less 1, a triangular
+/// distribution, whose rounding error has a mean and a variance that do
+/// not depend on the value rounded (a uniform dither's variance does).
+/// The same for the three channels: grain in brightness, not in colour.
+#[inline]
+pub fn output_dither(index: u32) -> f32 {
+    let h = hash_u32(index);
+    let a = ((h & 0xffff) as f32 + 0.5) / 65536.0;
+    let b = ((h >> 16) as f32 + 0.5) / 65536.0;
+    a + b - 1.0
+}
+
+/// The sRGB-encoded value `e` (0..1) plus `noise` levels of 255
+/// (`dither_encoded` in WGSL), before the rounding to 8 bits. Without it
+/// a smooth gradient that spans a few levels (a dusk sky: the whole
+/// twilight arch within 10-20 levels) rounds into flat bands with
+/// visible steps; with it each pixel rounds up or down in proportion to
+/// where its value lies between the levels, and the eye averages the
+/// grain back into the gradient. The noise fades out within a level of
+/// black and of white, so black stays black and white stays white.
+#[inline]
+pub fn dither_encoded(e: f32, noise: f32) -> f32 {
+    let room = (e.min(1.0 - e) * 255.0).clamp(0.0, 1.0);
+    e + noise * room / 255.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The dither keeps what lies between two levels: a flat value 0.3 of
+    /// a level above level 40 rounds to 40 everywhere without it (0.3
+    /// levels off in the mean, a band), and to a mix of 39s, 40s and 41s whose
+    /// mean is within 0.03 levels of 40.3 with it. Black and white stay
+    /// exact, and the noise is triangular: mean 0, variance 1/6.
+    #[test]
+    fn the_dither_keeps_the_levels_between_levels() {
+        // The radiance whose tone map encodes to 40.3 levels (bisection).
+        let target = 40.3 / 255.0;
+        let (mut lo, mut hi) = (0.0_f32, 1.0_f32);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if srgb_encode(tone_map(Vec3::splat(mid), 1.0).y) < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let flat = vec![Vec3::splat(lo); 64 * 64];
+        let bytes = to_srgb8(&flat, 1.0);
+        let mean = bytes.iter().map(|&b| b as f64).sum::<f64>() / bytes.len() as f64;
+        assert!((mean - 40.3).abs() < 0.03, "{mean}");
+        // Within a level of it (triangular noise spans two).
+        assert!(bytes.iter().all(|&b| (39..=41).contains(&b)));
+        // Black and white are not dithered.
+        assert!(
+            to_srgb8(&vec![Vec3::ZERO; 4096], 1.0)
+                .iter()
+                .all(|&b| b == 0)
+        );
+        assert!(
+            to_srgb8(&vec![Vec3::splat(1e6); 4096], 1.0)
+                .iter()
+                .all(|&b| b == 255)
+        );
+        // Triangular over (-1, 1).
+        let n = 1 << 16;
+        let v: Vec<f64> = (0..n).map(|i| output_dither(i) as f64).collect();
+        let m = v.iter().sum::<f64>() / n as f64;
+        let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / n as f64;
+        assert!(
+            m.abs() < 0.01 && (var - 1.0 / 6.0).abs() < 0.01,
+            "{m} {var}"
+        );
+        assert!(v.iter().all(|x| x.abs() < 1.0));
+    }
 
     /// The fitted ACES curve's landmarks, its monotony and its roll-off:
     /// black stays black, a neutral grey stays neutral, brighter is never

@@ -21,6 +21,18 @@ pub fn is_hdr(format: wgpu::TextureFormat) -> bool {
     )
 }
 
+/// Whether the composite dithers into `format` (`DITHER`): its 8-bit
+/// colour formats, as the CPU's `to_srgb8` does.
+pub fn dithers(format: wgpu::TextureFormat) -> bool {
+    matches!(
+        format,
+        wgpu::TextureFormat::Rgba8Unorm
+            | wgpu::TextureFormat::Rgba8UnormSrgb
+            | wgpu::TextureFormat::Bgra8Unorm
+            | wgpu::TextureFormat::Bgra8UnormSrgb
+    )
+}
+
 /// One pipeline per background, built on first use.
 #[derive(Default)]
 pub struct CompositePass {
@@ -70,6 +82,7 @@ impl CompositePass {
         let mut constants = constants.to_vec();
         constants.push(("ENCODE_SRGB", encode));
         constants.push(("TONE_MAP", (!is_hdr(target_format)) as u8 as f64));
+        constants.push(("DITHER", dithers(target_format) as u8 as f64));
         let pipeline = bind::full_screen_pipeline(
             device,
             "composite",

@@ -114,13 +114,13 @@ pub fn composite_pass(background: Background, physical: bool) -> String {
     let mut s = format!("{}{COMPOSITE}\n", shared(physical));
     match background {
         Background::Sky => s.push_str(
-            "fn terrain_hides(px: vec2i) -> bool {\n    return false;\n}\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy) + glare_at(pos.xy)), 1.0);\n}\n",
+            "fn terrain_hides(px: vec2i) -> bool {\n    return false;\n}\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy) + glare_at(pos.xy), pos.xy), 1.0);\n}\n",
         ),
         Background::Terrain => s.push_str(
-            "@group(1) @binding(1) var background_tex: texture_2d<f32>;\nfn terrain_hides(px: vec2i) -> bool {\n    return textureLoad(background_tex, px, 0).a > 0.5;\n}\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let b = textureLoad(background_tex, vec2i(pos.xy), 0);\n    var bg = sky_background(pos.xy);\n    if b.a > 0.5 {\n        bg = b.rgb;\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * bg + glare_at(pos.xy)), 1.0);\n}\n",
+            "@group(1) @binding(1) var background_tex: texture_2d<f32>;\nfn terrain_hides(px: vec2i) -> bool {\n    return textureLoad(background_tex, px, 0).a > 0.5;\n}\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let b = textureLoad(background_tex, vec2i(pos.xy), 0);\n    var bg = sky_background(pos.xy);\n    if b.a > 0.5 {\n        bg = b.rgb;\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * bg + glare_at(pos.xy), pos.xy), 1.0);\n}\n",
         ),
         Background::ExternalDepth => s.push_str(
-            "@group(1) @binding(1) var depth_tex: texture_depth_2d;\nfn terrain_hides(px: vec2i) -> bool {\n    return true;\n}\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if is_geometry(d) {\n        return vec4f(display(c.rgb), c.a);\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy)), 1.0);\n}\n",
+            "@group(1) @binding(1) var depth_tex: texture_depth_2d;\nfn terrain_hides(px: vec2i) -> bool {\n    return true;\n}\n@fragment\nfn fs_composite(@builtin(position) pos: vec4f) -> @location(0) vec4f {\n    let c = textureLoad(cloud_tex, vec2i(pos.xy), 0);\n    let d = textureLoad(depth_tex, vec2i(pos.xy), 0);\n    if is_geometry(d) {\n        return vec4f(display(c.rgb, pos.xy), c.a);\n    }\n    return vec4f(display(c.rgb + (1.0 - c.a) * sky_background(pos.xy), pos.xy), 1.0);\n}\n",
         ),
     }
     s

@@ -87,6 +87,10 @@ impl StandalonePass {
             "TONE_MAP",
             (!super::composite_pass::is_hdr(format)) as u8 as f64,
         ));
+        constants.push((
+            "DITHER",
+            super::composite_pass::dithers(format) as u8 as f64,
+        ));
         let pipeline = bind::full_screen_pipeline(
             device,
             label,
