@@ -89,7 +89,8 @@ fn sky_background(pos: vec2f) -> vec3f {
 // The sun's glare (src/render/cpu/glare.rs, the twins of its functions):
 // the CIE glare spread's small-angle term around the sun, lit by the sun
 // disk's irradiance at the camera times its visibility through the cloud
-// layer at GLARE_TAPS pixels across the disk, times render.sun_glare
+// layer at GLARE_TAPS pixels across the disk (a tap below the horizon, on
+// the flat ground or sea, hidden), times render.sun_glare
 // (frame.exposure.w). Only a tone-mapped target gets it. Each variant of
 // fs_composite defines terrain_hides(px): whether its background hides
 // the sky at pixel px.
@@ -148,7 +149,7 @@ fn sun_visibility(sun_dir: vec3f) -> f32 {
     var sum = 0.0;
     for (var tap = 0u; tap < GLARE_TAPS; tap++) {
         let p = glare_tap(centre.xy, radius, tap);
-        if !terrain_hides(p) {
+        if !terrain_hides(p) && camera_ray(vec2f(p) + 0.5).y >= 0.0 {
             sum += 1.0 - textureLoad(cloud_tex, p, 0).a;
         }
     }

@@ -10,8 +10,8 @@ use super::ReportError;
 use super::plot::{Series, loglog_png};
 use crate::io::write_atomically;
 use crate::render::cpu::renderer::{
-    Frame, render_clouds_linear, render_converged, render_linear, render_linear_offsets, to_srgb8,
-    tone_map,
+    Frame, render_clouds_linear, render_converged, render_linear, render_linear_offsets,
+    to_srgb8_exact, tone_map,
 };
 use crate::render::sampling::JITTER_CYCLE;
 
@@ -254,7 +254,7 @@ pub fn cloud_mask(frame: &Frame, width: u32, height: u32) -> Vec<bool> {
 pub fn highpass_reference(frame: &Frame, width: u32, height: u32) -> Vec<u8> {
     let mut f = *frame;
     f.quality.steps = HIGHPASS_REFERENCE_STEPS;
-    to_srgb8(
+    to_srgb8_exact(
         &render_converged(width, height, &f, JITTER_CYCLE),
         f.quality.exposure,
     )
@@ -266,15 +266,15 @@ pub fn measure_highpass(frame: &Frame, width: u32, height: u32) -> HighPass {
     let mask = cloud_mask(frame, width, height);
     let energy = |img: &[u8]| highpass_energy(img, &mask, width, height);
     let reference = energy(&highpass_reference(frame, width, height));
-    let one = to_srgb8(&render_linear(width, height, frame), exposure);
-    let many = to_srgb8(
+    let one = to_srgb8_exact(&render_linear(width, height, frame), exposure);
+    let many = to_srgb8_exact(
         &render_converged(width, height, frame, JITTER_CYCLE),
         exposure,
     );
     let (one_frame, converged) = (energy(&one), energy(&many));
     // The dither's own error: one frame against the mean of its frames'
     // offsets through the same pixel centres.
-    let centres = to_srgb8(
+    let centres = to_srgb8_exact(
         &render_linear_offsets(width, height, frame, JITTER_CYCLE),
         exposure,
     );

@@ -111,7 +111,10 @@ pub fn sun_radius_px(pixel_spread: f32) -> f32 {
 /// The sun's visibility through the clouds, 0..1 (`sun_visibility` in
 /// WGSL): the mean over the [`GLARE_TAPS`] of `transmittance(x, y)`, the
 /// cloud layer's transmittance at pixel `(x, y)` (0 where terrain hides
-/// the sky); 0 for a sun behind the camera.
+/// the sky); a tap whose ray points below the horizon counts 0, as the
+/// flat ground or sea is drawn there (a sun that has set behind it glares
+/// no more, whatever light the sky model still gives it); 0 for a sun
+/// behind the camera.
 pub fn sun_visibility(
     view: &View,
     width: u32,
@@ -126,7 +129,12 @@ pub fn sun_visibility(
     let sum: f32 = (0..GLARE_TAPS)
         .map(|tap| {
             let [x, y] = glare_tap(centre, radius, tap, width, height);
-            transmittance(x, y)
+            let ray = view.camera_ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
+            if ray.y < 0.0 {
+                0.0
+            } else {
+                transmittance(x, y)
+            }
         })
         .sum();
     sum / GLARE_TAPS as f32
@@ -223,6 +231,17 @@ mod tests {
         assert!((half - 0.8).abs() < 1e-6, "{half}");
         // A sun behind the camera is not seen.
         assert_eq!(sun_visibility(&view, w, h, -sun, |_, _| 1.0), 0.0);
+        // Nor one that has set behind the flat ground: the taps below the
+        // horizon are hidden, those above it are not (half the disk up).
+        let level = Camera {
+            pitch_deg: 0.0,
+            ..cam
+        }
+        .view(1.0, 40_000.0);
+        let set = Vec3::new(0.0, -0.02, 1.0).normalize();
+        assert_eq!(sun_visibility(&level, w, h, set, |_, _| 1.0), 0.0);
+        let half = sun_visibility(&level, w, h, Vec3::Z, |_, _| 1.0);
+        assert!(half > 0.0 && half < 1.0, "{half}");
         // A sun outside the frame reads the pixels on its edge.
         let off = view.camera_ray(260.0, 100.0, w, h);
         let edge = sun_visibility(&view, w, h, off, |x, _| if x == w - 1 { 0.5 } else { 1.0 });

@@ -22,7 +22,9 @@ use super::sky::{
     sky_ambient, sun_direction, sun_disk_irradiance, sun_light_at,
 };
 use super::sky_luts::SkyLuts;
-pub use super::tone_map::{ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, tone_map};
+pub use super::tone_map::{
+    ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, to_srgb8_exact, tone_map,
+};
 use super::waves::sea_waves_at;
 use crate::render::camera::View;
 use crate::render::sampling::{self, frame_offset, jitter};

@@ -63,13 +63,25 @@ pub fn srgb_encode(x: f32) -> f32 {
 }
 
 /// Tone map ([`tone_map`]), sRGB-encode and dither ([`dither_encoded`]
-/// by [`output_dither`] of the pixel's row-major index) to 8 bits.
+/// by [`output_dither`] of the pixel's row-major index) to 8 bits: the
+/// pictures.
 pub fn to_srgb8(linear: &[Vec3], exposure: f32) -> Vec<u8> {
+    quantize(linear, exposure, true)
+}
+
+/// [`to_srgb8`] without the dither: for measurements of an image's own
+/// fine structure (the high-pass energy of `report::render_quality`),
+/// which the dither's grain would add to.
+pub fn to_srgb8_exact(linear: &[Vec3], exposure: f32) -> Vec<u8> {
+    quantize(linear, exposure, false)
+}
+
+fn quantize(linear: &[Vec3], exposure: f32, dither: bool) -> Vec<u8> {
     linear
         .iter()
         .enumerate()
         .flat_map(|(i, &c)| {
-            let noise = output_dither(i as u32);
+            let noise = if dither { output_dither(i as u32) } else { 0.0 };
             let enc = |x: f32| {
                 let e = dither_encoded(srgb_encode(x).clamp(0.0, 1.0), noise);
                 (e * 255.0 + 0.5).floor().clamp(0.0, 255.0) as u8
