@@ -19,6 +19,7 @@ pub mod sky;
 pub mod sky_luts;
 pub mod spheroids;
 pub mod standalone;
+pub mod stills;
 pub mod tone_map;
 pub mod volume;
 pub mod waves;
