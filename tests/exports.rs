@@ -10,6 +10,7 @@ use std::process::{Command, Output};
 use cumulus::prepare::Prepared;
 use cumulus::render::cpu::density::density_at;
 use cumulus::render::cpu::renderer::{to_srgb8, tone_map};
+use cumulus::report::vdb::read_vdb;
 use cumulus::report::volume_export::{Grid, read_vol};
 use cumulus::scene::Scene;
 use glam::Vec3;
@@ -241,6 +242,90 @@ fn export_writes_the_density_the_renderer_marches() {
     assert_eq!(j["width"], 640);
 }
 
+/// A Python with OpenVDB's binding (`python3-openvdb`), if one is
+/// installed: Debian's goes into the system's Python, which another
+/// `python3` on the path may not be.
+fn python_with_openvdb() -> Option<&'static str> {
+    ["python3", "/usr/bin/python3"].into_iter().find(|py| {
+        Command::new(py)
+            .args(["-c", "import pyopenvdb"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    })
+}
+
+/// `cumulus export --out clouds.vdb` writes the grid `--out clouds.vol`
+/// does, as OpenVDB's fog volume: read back by `read_vdb`, every cloudy
+/// cell is an active voxel of the same value at the same place, and no
+/// other; and OpenVDB's own library reads the file to the same values
+/// (`tests/openvdb_reads.py`), where it is installed. CI installs it and
+/// sets `CUMULUS_REQUIRE_OPENVDB=1`, so there it cannot be skipped.
+#[test]
+fn export_writes_openvdb_files_openvdb_reads() {
+    let dir = tempfile::tempdir().expect("dir");
+    let scene = scene_path("fair_weather");
+    let (vol, vdb) = (dir.path().join("c.vol"), dir.path().join("c.vdb"));
+    for out in [&vol, &vdb] {
+        let o = cumulus(&[
+            "export",
+            "--scene",
+            scene.to_str().expect("utf-8"),
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--cells",
+            "48",
+            "--time-s",
+            "900",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let (grid, values) = read_vol(&vol).expect("vol");
+    let back = read_vdb(&vdb).expect("the .vdb reads back");
+    assert_eq!(back.class.as_deref(), Some("fog volume"));
+    let cloudy: Vec<([i32; 3], f32)> = (0..grid.len())
+        .filter(|&n| values[n] > 0.0)
+        .map(|n| {
+            let [nx, ny, _] = grid.resolution.map(|v| v as usize);
+            (
+                [n % nx, (n / nx) % ny, n / (nx * ny)].map(|v| v as i32),
+                values[n],
+            )
+        })
+        .collect();
+    assert!(cloudy.len() > 100, "{} cloudy cells", cloudy.len());
+    let mut voxels = back.voxels.clone();
+    voxels.sort_by_key(|(ijk, _)| [ijk[2], ijk[1], ijk[0]]);
+    assert_eq!(voxels, cloudy);
+    let centre = grid.centre(3, 2, 5);
+    for (a, (t, s)) in back.translation.iter().zip(back.scale).enumerate() {
+        let world = t + s * [3.0, 2.0, 5.0][a];
+        assert!((world - centre[a] as f64).abs() < 1e-2, "{world} {centre}");
+    }
+    let text = std::fs::read_to_string(vdb.with_extension("json")).expect("sidecar");
+    assert!(text.contains("\"volume\": \"c.vdb\""), "{text}");
+
+    let Some(py) = python_with_openvdb() else {
+        assert!(
+            std::env::var_os("CUMULUS_REQUIRE_OPENVDB").is_none(),
+            "CUMULUS_REQUIRE_OPENVDB is set but no python3 imports pyopenvdb"
+        );
+        eprintln!("OpenVDB's Python binding is not installed: its read of the .vdb is skipped");
+        return;
+    };
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/openvdb_reads.py");
+    let o = Command::new(py)
+        .arg(&script)
+        .args([&vdb, &vol])
+        .output()
+        .expect("python runs");
+    assert!(
+        o.status.success(),
+        "OpenVDB's reader: {}{}",
+        String::from_utf8_lossy(&o.stdout),
+        stderr(&o)
+    );
+}
+
 #[test]
 fn export_refuses_bad_grids_boxes_and_names_before_simulating() {
     let dir = tempfile::tempdir().expect("dir");
@@ -271,7 +356,7 @@ fn export_refuses_bad_grids_boxes_and_names_before_simulating() {
         (&["--out", vol, "--box", "0,1,2"], &["--box"]),
         (
             &["--out", &format!("{}/v.raw", dir.path().display())],
-            &["v.raw", ".vol"],
+            &["v.raw", ".vol", ".vdb"],
         ),
     ];
     for (args, says) in cases {

@@ -1,7 +1,8 @@
 //! `cumulus export`: the density field the renderer marches, sampled on a
 //! regular grid, for offline renderers (Mitsuba, Blender, Houdini).
 //!
-//! The grid is written as a Mitsuba 3 grid volume (`.vol`, the format its
+//! The grid is written as an OpenVDB file ([`super::vdb`]) or as a
+//! Mitsuba 3 grid volume (`.vol`, the format its
 //! `gridvolume` texture reads): the bytes `VOL`, version 3, encoding 1
 //! (32-bit float), the resolution (x, y, z) and one channel as
 //! little-endian `i32`, the bounding box (min x, y, z, max x, y, z) as
@@ -31,6 +32,10 @@ pub const MAX_CELLS: u32 = 2048;
 /// The largest number of cells in all (2^28: a 1 GiB file).
 pub const MAX_TOTAL_CELLS: u64 = 1 << 28;
 
+/// What the exported values are (the sidecar's `quantity`, and the
+/// `.vdb` grid's `cumulus_quantity` metadata).
+pub const QUANTITY: &str = "extinction coefficient sigma_t, 1/m, at cell centres";
+
 /// The size of a `.vol` file's header, bytes.
 pub const HEADER_BYTES: usize = 48;
 
@@ -50,6 +55,8 @@ pub enum VolumeError {
     },
     #[error("{path}: not a Mitsuba grid volume: {reason}")]
     Format { path: PathBuf, reason: String },
+    #[error("{path}: not an OpenVDB file cumulus reads: {reason}")]
+    Vdb { path: PathBuf, reason: String },
 }
 
 /// A regular grid over an axis-aligned box of the world (metres; y up).
@@ -314,10 +321,10 @@ pub struct Lobe {
 }
 
 /// What an offline renderer needs besides the grid to render the same
-/// clouds as ours (written beside the `.vol` as JSON).
+/// clouds as ours (written beside the `.vol` or `.vdb` as JSON).
 #[derive(Debug, Clone, Serialize)]
 pub struct Sidecar {
-    /// The `.vol` file's name.
+    /// The volume file's name (`.vol` or `.vdb`).
     pub volume: String,
     pub quantity: &'static str,
     /// World axes and units.
@@ -375,7 +382,7 @@ impl Sidecar {
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
-            quantity: "extinction coefficient sigma_t, 1/m, at cell centres",
+            quantity: QUANTITY,
             world: "metres; x east, y up, z north",
             resolution: grid.resolution,
             box_min_m: grid.min_m.to_array(),

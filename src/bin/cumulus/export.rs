@@ -1,6 +1,7 @@
 //! `cumulus export`: simulate a scene, then write the density field the
-//! renderer marches as a Mitsuba 3 grid volume (`.vol`) with a JSON
-//! sidecar of the sun, camera, phase function and albedo.
+//! renderer marches as a Mitsuba 3 grid volume (`.vol`) or an OpenVDB
+//! file (`.vdb`), with a JSON sidecar of the sun, camera, phase function
+//! and albedo.
 
 use std::path::PathBuf;
 
@@ -8,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use glam::Vec3;
 
 use cumulus::prepare::Prepared;
+use cumulus::report::vdb;
 use cumulus::report::volume_export::{self, Grid, Sidecar};
 
 use crate::{
@@ -16,15 +18,16 @@ use crate::{
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Example:\n  cumulus export --scene scenes/fair_weather.toml --out clouds.vol --sky sky.exr\n  cumulus export --scene scenes/bomex.toml --out bomex.vol --cells 512 --box 0,500,0,4000,2500,4000"
+    after_help = "Example:\n  cumulus export --scene scenes/fair_weather.toml --out clouds.vol --sky sky.exr\n  cumulus export --scene scenes/bomex.toml --out bomex.vol --cells 512 --box 0,500,0,4000,2500,4000\n  cumulus export --scene scenes/fair_weather.toml --out clouds.vdb --cells 512"
 )]
 pub struct ExportArgs {
     /// Scene TOML file.
     #[arg(long)]
     scene: PathBuf,
-    /// Output volume, .vol (Mitsuba 3 grid volume: extinction per metre).
-    /// The sidecar is written beside it with the extension .json. Both
-    /// are written atomically.
+    /// Output volume of the extinction per metre: .vol (a Mitsuba 3 grid
+    /// volume) or .vdb (OpenVDB: a fog volume named "density", for
+    /// Blender and Houdini; y up). The sidecar is written beside it with
+    /// the extension .json. Both are written atomically.
     #[arg(long)]
     out: PathBuf,
     /// Cells along the box's longest side (1..=2048); the other sides get
@@ -49,12 +52,14 @@ pub fn run(a: ExportArgs) -> Result<()> {
         .out
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase());
-    if ext.as_deref() != Some("vol") {
-        bail!(
-            "{}: --out must end in .vol (a Mitsuba 3 grid volume)",
+    let vdb = match ext.as_deref() {
+        Some("vol") => false,
+        Some("vdb") => true,
+        _ => bail!(
+            "{}: --out must end in .vol (a Mitsuba 3 grid volume) or .vdb (OpenVDB)",
             a.out.display()
-        );
-    }
+        ),
+    };
     if let Some(b) = &a.r#box
         && b.len() != 6
     {
@@ -104,7 +109,11 @@ pub fn run(a: ExportArgs) -> Result<()> {
     guard_output_file(&a.out);
     guard_output_file(&sidecar_path);
     let values = volume_export::sample(&frame, &grid);
-    volume_export::write_vol(&a.out, &grid, &values)?;
+    if vdb {
+        vdb::write_vdb(&a.out, &grid, &values, volume_export::QUANTITY)?;
+    } else {
+        volume_export::write_vol(&a.out, &grid, &values)?;
+    }
     let info = (r.fov_deg, r.width, r.height, r.time_s);
     Sidecar::new(&a.out, &grid, &values, &frame, info).write(&sidecar_path)?;
     if let Some(sky) = &a.sky {

@@ -1,0 +1,133 @@
+use glam::Vec3;
+
+use super::*;
+
+/// A grid over three lower nodes along x (130 cells > 128) and several
+/// leaves along y and z, cloudy in a few scattered cells.
+fn cloudy_grid() -> (Grid, Vec<f32>) {
+    let g = Grid::new(
+        [130, 11, 17],
+        Vec3::new(-100.0, 500.0, 20.0),
+        Vec3::new(1200.0, 610.0, 190.0),
+    )
+    .expect("grid");
+    let mut values = vec![0.0; g.len()];
+    for (n, [i, j, k]) in [[0, 0, 0], [7, 8, 16], [8, 3, 9], [129, 10, 16], [64, 5, 2]]
+        .into_iter()
+        .enumerate()
+    {
+        values[g.index(i, j, k)] = 0.01 * (n + 1) as f32;
+    }
+    (g, values)
+}
+
+/// What was written is read back: every cloudy cell at its index with
+/// its value, nothing else active, and the transform taking index
+/// `(i, j, k)` to the cell's centre.
+#[test]
+fn vdb_files_round_trip() {
+    let (g, values) = cloudy_grid();
+    let dir = tempfile::tempdir().expect("dir");
+    let path = dir.path().join("v.vdb");
+    write_vdb(&path, &g, &values, "sigma_t").expect("write");
+    let back = read_vdb(&path).expect("read");
+    assert_eq!(back.name, GRID_NAME);
+    assert_eq!(back.class.as_deref(), Some("fog volume"));
+    assert_eq!(back.background, 0.0);
+    let mut expected: Vec<([i32; 3], f32)> = Vec::new();
+    for k in 0..17 {
+        for j in 0..11 {
+            for i in 0..130 {
+                let v = values[g.index(i, j, k)];
+                if v > 0.0 {
+                    expected.push(([i as i32, j as i32, k as i32], v));
+                }
+            }
+        }
+    }
+    let mut got = back.voxels.clone();
+    got.sort_by_key(|(ijk, _)| [ijk[2], ijk[1], ijk[0]]);
+    assert_eq!(got, expected);
+    for ijk in [[0, 0, 0], [129, 10, 16], [64, 5, 2]] {
+        let world: [f64; 3] =
+            std::array::from_fn(|a| back.translation[a] + back.scale[a] * ijk[a] as f64);
+        let centre = g.centre(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
+        for a in 0..3 {
+            assert!(
+                (world[a] - centre[a] as f64).abs() < 1e-3,
+                "{world:?} {centre}"
+            );
+        }
+    }
+}
+
+/// The bytes start as OpenVDB's do, are the same for the same grid, and
+/// leave out the empty leaves: an empty grid is the header, the
+/// descriptor and a root with no children.
+#[test]
+fn vdb_bytes_follow_openvdbs_header() {
+    let (g, values) = cloudy_grid();
+    let b = vdb_bytes(&g, &values, "sigma_t").expect("bytes");
+    assert_eq!(&b[..8], b" BDV\0\0\0\0");
+    assert_eq!(u32::from_le_bytes(b[8..12].try_into().expect("4")), 224);
+    assert_eq!(b[20], 1);
+    let uuid = std::str::from_utf8(&b[21..57]).expect("uuid");
+    assert_eq!(uuid.len(), 36);
+    assert_eq!(uuid.matches('-').count(), 4);
+    assert_eq!(b, vdb_bytes(&g, &values, "sigma_t").expect("again"));
+    // Five cloudy cells in five leaves: each leaf costs its topology
+    // mask (64 bytes) and its data (64 + 1 + 2048 bytes).
+    let empty = vdb_bytes(&g, &vec![0.0; g.len()], "sigma_t").expect("empty");
+    assert!(b.len() > empty.len() + 5 * (64 + 64 + 1 + 2048));
+    assert!(empty.len() < 1000, "{}", empty.len());
+    assert!(vdb_bytes(&g, &[1.0], "sigma_t").is_err());
+}
+
+#[test]
+fn broken_vdb_files_are_refused_with_the_reason() {
+    let dir = tempfile::tempdir().expect("dir");
+    let (g, values) = cloudy_grid();
+    let good = vdb_bytes(&g, &values, "sigma_t").expect("bytes");
+    let grid_pos = {
+        // The compression flags follow the descriptor's three offsets.
+        let at = good
+            .windows(GRID_TYPE.len())
+            .position(|w| w == GRID_TYPE.as_bytes());
+        let at = at.expect("type") + GRID_TYPE.len() + 4;
+        i64::from_le_bytes(good[at..at + 8].try_into().expect("8")) as usize
+    };
+    let mut compressed = good.clone();
+    compressed[grid_pos] = 4; // COMPRESS_BLOSC
+    let cases: [(&str, Vec<u8>, &str); 4] = [
+        ("magic", [b"VDB ".as_slice(), &good[4..]].concat(), "magic"),
+        ("cut", good[..good.len() - 10].to_vec(), "ends at byte"),
+        (
+            "version",
+            [&good[..8], &300_u32.to_le_bytes()[..], &good[12..]].concat(),
+            "file format 300",
+        ),
+        ("compressed", compressed, "compressed"),
+    ];
+    for (name, bytes, says) in cases {
+        let p = dir.path().join(format!("{name}.vdb"));
+        write_atomically(&p, |out| out.write_all(&bytes)).expect("write");
+        let e = read_vdb(&p).expect_err(name).to_string();
+        assert!(
+            e.contains(says) && e.contains(&format!("{name}.vdb")),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn child_offsets_are_openvdbs() {
+    // z fastest, x slowest, within each level.
+    assert_eq!(child_offset(0, 0, 1, LEAF_LOG2, 0), 1);
+    assert_eq!(child_offset(0, 1, 0, LEAF_LOG2, 0), 8);
+    assert_eq!(child_offset(1, 0, 0, LEAF_LOG2, 0), 64);
+    assert_eq!(child_offset(9, 0, 0, LEAF_LOG2, 0), 64);
+    assert_eq!(child_offset(8, 0, 0, 4, LEAF_LOG2), 256);
+    assert_eq!(child_offset(0, 0, 8, 4, LEAF_LOG2), 1);
+    assert_eq!(child_offset(128, 0, 0, 5, LOWER_TOTAL), 1024);
+    assert_eq!(child_offset(4096 + 128, 0, 0, 5, LOWER_TOTAL), 1024);
+}
