@@ -246,9 +246,10 @@ fn export_writes_the_density_the_renderer_marches() {
 /// installed: Debian's goes into the system's Python, which another
 /// `python3` on the path may not be.
 fn python_with_openvdb() -> Option<&'static str> {
+    let probe = "import numpy\ntry:\n    import pyopenvdb\nexcept ImportError:\n    import openvdb";
     ["python3", "/usr/bin/python3"].into_iter().find(|py| {
         Command::new(py)
-            .args(["-c", "import pyopenvdb"])
+            .args(["-c", probe])
             .output()
             .is_ok_and(|o| o.status.success())
     })
@@ -272,8 +273,9 @@ fn export_writes_openvdb_files_openvdb_reads() {
             scene.to_str().expect("utf-8"),
             "--out",
             out.to_str().expect("utf-8"),
+            // 160 cells across: two of OpenVDB's 128-voxel nodes a side.
             "--cells",
-            "48",
+            "160",
             "--time-s",
             "900",
         ]);
@@ -301,29 +303,59 @@ fn export_writes_openvdb_files_openvdb_reads() {
         let world = t + s * [3.0, 2.0, 5.0][a];
         assert!((world - centre[a] as f64).abs() < 1e-2, "{world} {centre}");
     }
+    assert!(grid.resolution[0] > 128, "{:?}", grid.resolution);
     let text = std::fs::read_to_string(vdb.with_extension("json")).expect("sidecar");
-    assert!(text.contains("\"volume\": \"c.vdb\""), "{text}");
+    let j: serde_json::Value = serde_json::from_str(&text).expect("json");
+    assert_eq!(j["volume"], "c.vdb");
+    // The .vdb places itself: the sidecar's matrix is the identity.
+    for r in 0..4 {
+        for c in 0..4 {
+            let want = if r == c { 1.0 } else { 0.0 };
+            assert_eq!(j["to_world"][r][c].as_f64(), Some(want), "{text}");
+        }
+    }
 
     let Some(py) = python_with_openvdb() else {
         assert!(
             std::env::var_os("CUMULUS_REQUIRE_OPENVDB").is_none(),
-            "CUMULUS_REQUIRE_OPENVDB is set but no python3 imports pyopenvdb"
+            "CUMULUS_REQUIRE_OPENVDB is set but no python3 imports OpenVDB's binding and numpy"
         );
+        // Shown with --nocapture: a passing test's output is hidden.
         eprintln!("OpenVDB's Python binding is not installed: its read of the .vdb is skipped");
         return;
     };
+    // And a box above the clouds: a grid with no active voxel.
+    let (empty_vol, empty_vdb) = (dir.path().join("e.vol"), dir.path().join("e.vdb"));
+    for out in [&empty_vol, &empty_vdb] {
+        let o = cumulus(&[
+            "export",
+            "--scene",
+            scene.to_str().expect("utf-8"),
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--cells",
+            "8",
+            "--box",
+            "0,9000,0,100,9100,100",
+            "--time-s",
+            "900",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/openvdb_reads.py");
-    let o = Command::new(py)
-        .arg(&script)
-        .args([&vdb, &vol])
-        .output()
-        .expect("python runs");
-    assert!(
-        o.status.success(),
-        "OpenVDB's reader: {}{}",
-        String::from_utf8_lossy(&o.stdout),
-        stderr(&o)
-    );
+    for (vdb, vol) in [(&vdb, &vol), (&empty_vdb, &empty_vol)] {
+        let o = Command::new(py)
+            .arg(&script)
+            .args([vdb, vol])
+            .output()
+            .expect("python runs");
+        assert!(
+            o.status.success(),
+            "OpenVDB's reader: {}{}",
+            String::from_utf8_lossy(&o.stdout),
+            stderr(&o)
+        );
+    }
 }
 
 #[test]

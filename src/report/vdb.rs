@@ -96,8 +96,8 @@ struct Leaf {
 /// z), each holding its lower nodes by offset, each its leaves by offset.
 type Tree = BTreeMap<[i32; 3], BTreeMap<usize, BTreeMap<usize, Leaf>>>;
 
-/// The leaves of `values` on `grid` (σ_t > 0 active; NaN and the rest
-/// inactive at 0), gathered into the tree.
+/// The leaves of `values` on `grid` (σ_t > 0 active, +∞ included; NaN
+/// and the rest inactive at 0), gathered into the tree.
 fn build_tree(grid: &Grid, values: &[f32]) -> Tree {
     let [nx, ny, nz] = grid.resolution.map(|n| n as i32);
     let side = 1 << LEAF_LOG2;
@@ -109,9 +109,10 @@ fn build_tree(grid: &Grid, values: &[f32]) -> Tree {
                     mask: Mask::new(LEAF_SIZE),
                     values: vec![0.0; LEAF_SIZE],
                 };
-                for x in lx..(lx + side as i32).min(nx) {
+                // x innermost: the grid's own order.
+                for z in lz..(lz + side as i32).min(nz) {
                     for y in ly..(ly + side as i32).min(ny) {
-                        for z in lz..(lz + side as i32).min(nz) {
+                        for x in lx..(lx + side as i32).min(nx) {
                             let v = values[grid.index(x as u32, y as u32, z as u32)];
                             if v > 0.0 {
                                 let n = child_offset(x, y, z, LEAF_LOG2, 0);
@@ -185,6 +186,7 @@ enum Meta {
     Str(String),
     Vec3i([i32; 3]),
     Int64(i64),
+    Bool(bool),
 }
 
 /// A metadata map: the count, then each entry's name, type name, size in
@@ -208,16 +210,37 @@ fn write_meta(b: &mut Bytes, entries: &[(&str, Meta)]) {
                 b.u32(8);
                 b.i64(*v);
             }
+            Meta::Bool(v) => {
+                b.string("bool");
+                b.u32(1);
+                b.u8(*v as u8);
+            }
         }
     }
 }
 
-/// A UUID (version 4's layout) made from the values, so the same grid
-/// gives the same bytes.
-fn uuid(values: &[f32]) -> String {
+/// A UUID (version 4's layout) made from the grid's placement, what its
+/// values are and the values themselves: the same export gives the same
+/// bytes, and two different ones (an empty grid over another box
+/// included) different UUIDs.
+fn uuid(grid: &Grid, quantity: &str, values: &[f32]) -> String {
     let mut h = [0xcbf2_9ce4_8422_2325_u64, 0x6c62_272e_07bb_0142];
-    for (n, v) in values.iter().enumerate() {
-        let word = v.to_bits() as u64 ^ (n as u64) << 32;
+    let placement = grid.resolution.iter().map(|&n| n as u64);
+    let corners = grid
+        .min_m
+        .to_array()
+        .into_iter()
+        .chain(grid.max_m.to_array());
+    let words = placement
+        .chain(corners.map(|c| c.to_bits() as u64))
+        .chain(quantity.bytes().map(u64::from))
+        .chain(
+            values
+                .iter()
+                .enumerate()
+                .map(|(n, v)| v.to_bits() as u64 ^ (n as u64) << 32),
+        );
+    for word in words {
         h[0] = (h[0] ^ word).wrapping_mul(0x0000_0100_0000_01b3);
         h[1] = (h[1] ^ word.rotate_left(17)).wrapping_mul(0x0000_0100_0000_01b3);
     }
@@ -248,6 +271,19 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
             expected: "one per grid cell",
         });
     }
+    // The transform in f64 from the box itself (not the f32 cell size).
+    let (min, max) = (grid.min_m.as_dvec3(), grid.max_m.as_dvec3());
+    let cell = (max - min) / glam::UVec3::from_array(grid.resolution).as_dvec3();
+    if !cell.is_finite() || cell.min_element() <= 0.0 {
+        return Err(VolumeError::Bad {
+            what: "grid",
+            value: format!(
+                "{:?} cells over {} to {}",
+                grid.resolution, grid.min_m, grid.max_m
+            ),
+            expected: "cells of finite, positive size (Grid::new checks this)",
+        });
+    }
     let tree = build_tree(grid, values);
     let active: i64 = tree
         .values()
@@ -269,7 +305,7 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
     b.u32(LIBRARY_VERSION[0]);
     b.u32(LIBRARY_VERSION[1]);
     b.u8(1); // the grids' offsets follow their descriptors
-    b.0.extend_from_slice(uuid(values).as_bytes());
+    b.0.extend_from_slice(uuid(grid, quantity, values).as_bytes());
     let creator = format!("cumulus {}", env!("CARGO_PKG_VERSION"));
     write_meta(&mut b, &[("creator", Meta::Str(creator))]);
     b.i32(1); // one grid
@@ -288,13 +324,14 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
             ("cumulus_quantity", Meta::Str(quantity.into())),
             ("file_bbox_max", Meta::Vec3i(hi)),
             ("file_bbox_min", Meta::Vec3i(lo)),
+            ("file_compression", Meta::Str("none".into())),
             ("file_voxel_count", Meta::Int64(active)),
+            ("is_saved_as_half_float", Meta::Bool(false)),
             ("name", Meta::Str(GRID_NAME.into())),
         ],
     );
     // The transform: index (i, j, k) to cell (i, j, k)'s centre.
-    let cell = grid.cell_m().as_dvec3();
-    let first = grid.min_m.as_dvec3() + 0.5 * cell;
+    let first = min + 0.5 * cell;
     b.string("ScaleTranslateMap");
     b.f64s(first.to_array());
     b.f64s(cell.to_array());
@@ -344,8 +381,8 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
     Ok(b.0)
 }
 
-/// The index bounds of the active cells (σ_t > 0), inclusive; the whole
-/// grid's corner cells when none is.
+/// The index bounds of the active cells (σ_t > 0), inclusive; when none
+/// is, the empty box OpenVDB writes (min `i32::MAX`, max `i32::MIN`).
 fn active_bounds(grid: &Grid, values: &[f32]) -> ([i32; 3], [i32; 3]) {
     let [nx, ny, nz] = grid.resolution;
     let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
@@ -360,9 +397,6 @@ fn active_bounds(grid: &Grid, values: &[f32]) -> ([i32; 3], [i32; 3]) {
                 }
             }
         }
-    }
-    if lo[0] > hi[0] {
-        return ([0; 3], grid.resolution.map(|n| n as i32 - 1));
     }
     (lo, hi)
 }

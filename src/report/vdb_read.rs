@@ -166,11 +166,22 @@ pub fn read_vdb(path: &Path) -> Result<VdbGrid, VolumeError> {
     r.take(36)?; // the UUID
     r.meta()?;
     let grids = r.i32()?;
+    // Each descriptor takes at least 40 bytes: a count beyond what the
+    // rest of the file holds is not one.
+    if grids < 0 || grids as usize > (r.bytes.len() - r.at) / 40 {
+        return Err(r.bad(format!("{grids} grids in {} bytes", r.bytes.len())));
+    }
     for _ in 0..grids {
         let name = r.string()?;
         let kind = r.string()?;
         r.string()?; // the instance parent
         let (grid_pos, block_pos, end_pos) = (r.i64()?, r.i64()?, r.i64()?);
+        if !(r.at as i64 <= grid_pos && grid_pos <= block_pos && block_pos <= end_pos) {
+            return Err(r.bad(format!(
+                "grid {name}'s offsets {grid_pos}, {block_pos}, {end_pos} are not in order after byte {}",
+                r.at
+            )));
+        }
         if kind != GRID_TYPE {
             r.seek(end_pos)?;
             continue;
@@ -209,6 +220,14 @@ pub fn read_vdb(path: &Path) -> Result<VdbGrid, VolumeError> {
         let mut leaves = Vec::new();
         for _ in 0..children {
             let origin = [r.i32()?, r.i32()?, r.i32()?];
+            // An upper node's origin is a multiple of its span, so its
+            // children's and voxels' indices cannot overflow.
+            if origin
+                .iter()
+                .any(|v| v & ((1 << super::UPPER_TOTAL) - 1) != 0)
+            {
+                return Err(r.bad(format!("grid {name} has a node at {origin:?}")));
+            }
             let lowers = ones(&r.mask(1 << 15)?);
             if !ones(&r.mask(1 << 15)?).is_empty() {
                 return Err(r.bad(format!("grid {name} has active tiles")));

@@ -2,7 +2,7 @@ use glam::Vec3;
 
 use super::*;
 
-/// A grid over three lower nodes along x (130 cells > 128) and several
+/// A grid over two lower nodes along x (130 cells > 128) and several
 /// leaves along y and z, cloudy in a few scattered cells.
 fn cloudy_grid() -> (Grid, Vec<f32>) {
     let g = Grid::new(
@@ -81,6 +81,55 @@ fn vdb_bytes_follow_openvdbs_header() {
     assert!(b.len() > empty.len() + 5 * (64 + 64 + 1 + 2048));
     assert!(empty.len() < 1000, "{}", empty.len());
     assert!(vdb_bytes(&g, &[1.0], "sigma_t").is_err());
+    // Another box or quantity, another UUID; the same export, the same.
+    let other = Grid::new(g.resolution, g.min_m, g.max_m + Vec3::X).expect("grid");
+    let uuid_of = |b: &[u8]| b[21..57].to_vec();
+    let empty_other = vdb_bytes(&other, &vec![0.0; g.len()], "sigma_t").expect("empty");
+    assert_ne!(uuid_of(&empty), uuid_of(&empty_other));
+    let relabelled = vdb_bytes(&g, &values, "density").expect("bytes");
+    assert_ne!(uuid_of(&b), uuid_of(&relabelled));
+}
+
+/// A grid with no cloud is a root with no children, read back empty.
+#[test]
+fn an_empty_grid_reads_back_empty() {
+    let (g, _) = cloudy_grid();
+    let dir = tempfile::tempdir().expect("dir");
+    let path = dir.path().join("empty.vdb");
+    write_vdb(&path, &g, &vec![0.0; g.len()], "sigma_t").expect("write");
+    let back = read_vdb(&path).expect("read");
+    assert!(back.voxels.is_empty());
+    assert_eq!(back.class.as_deref(), Some("fog volume"));
+}
+
+/// No file makes the reader panic: every cut of a good file, and every
+/// byte of it flipped, is read or refused, never a crash.
+#[test]
+fn damaged_vdb_files_never_panic_the_reader() {
+    let (g, values) = cloudy_grid();
+    let good = vdb_bytes(&g, &values, "sigma_t").expect("bytes");
+    let dir = tempfile::tempdir().expect("dir");
+    let path = dir.path().join("d.vdb");
+    let mut refused = 0;
+    let mut tried = 0;
+    let mut check = |bytes: &[u8]| {
+        write_atomically(&path, |out| out.write_all(bytes)).expect("write");
+        tried += 1;
+        refused += read_vdb(&path).is_err() as u32;
+    };
+    for cut in (0..good.len()).step_by(97) {
+        check(&good[..cut]);
+    }
+    // Flips in the header, the descriptor, the metadata, the transform
+    // and the topology (the values themselves read as other values).
+    for at in (0..good.len().min(700)).chain((700..good.len()).step_by(211)) {
+        for flip in [0x01_u8, 0x80, 0xff] {
+            let mut bad = good.clone();
+            bad[at] ^= flip;
+            check(&bad);
+        }
+    }
+    assert!(tried > 2000 && refused > tried / 3, "{refused} of {tried}");
 }
 
 #[test]
@@ -98,7 +147,29 @@ fn broken_vdb_files_are_refused_with_the_reason() {
     };
     let mut compressed = good.clone();
     compressed[grid_pos] = 4; // COMPRESS_BLOSC
-    let cases: [(&str, Vec<u8>, &str); 4] = [
+    let find = |what: &[u8]| {
+        good.windows(what.len())
+            .position(|w| w == what)
+            .expect("found")
+    };
+    // The upper node's origin, after the transform and the root's
+    // buffer count, background, tiles and children: off its 4096 grid,
+    // near i32::MAX, where its children's indices would overflow.
+    let origin_at = find(b"ScaleTranslateMap") + 17 + 6 * 24 + 16;
+    let mut far = good.clone();
+    far[origin_at..origin_at + 4].copy_from_slice(&0x7fff_f001_i32.to_le_bytes());
+    // Two billion grids in a small file.
+    let count_at = find(b"\x07\0\0\0density") - 4;
+    let mut many = good.clone();
+    many[count_at..count_at + 4].copy_from_slice(&i32::MAX.to_le_bytes());
+    // The grid's end before its start.
+    let end_at = find(GRID_TYPE.as_bytes()) + GRID_TYPE.len() + 4 + 16;
+    let mut backwards = good.clone();
+    backwards[end_at..end_at + 8].copy_from_slice(&8_i64.to_le_bytes());
+    let cases: [(&str, Vec<u8>, &str); 7] = [
+        ("far", far, "a node at [2147479553"),
+        ("many", many, "2147483647 grids"),
+        ("backwards", backwards, "not in order"),
         ("magic", [b"VDB ".as_slice(), &good[4..]].concat(), "magic"),
         ("cut", good[..good.len() - 10].to_vec(), "ends at byte"),
         (

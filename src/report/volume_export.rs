@@ -333,8 +333,12 @@ pub struct Sidecar {
     pub box_min_m: [f32; 3],
     pub box_max_m: [f32; 3],
     pub cell_m: [f32; 3],
-    /// Row-major 4x4 matrix taking the unit cube `[0, 1]³` (Mitsuba's
-    /// volume space) onto the box.
+    /// The volume file's own space, which [`Self::to_world`] places.
+    pub volume_space: &'static str,
+    /// Row-major 4x4 matrix placing the volume in the world: for a `.vol`
+    /// the unit cube `[0, 1]³` (Mitsuba's volume space) onto the box;
+    /// for a `.vdb` the identity (its own transform already places its
+    /// voxels in metres).
     pub to_world: [[f32; 4]; 4],
     /// The largest value in the grid, 1/m (a majorant for delta tracking).
     pub max_extinction_per_m: f32,
@@ -377,6 +381,9 @@ impl Sidecar {
         let size = grid.max_m - grid.min_m;
         let (min, eye) = (grid.min_m, frame.view.eye());
         let forward = frame.view.camera_ray(0.5, 0.5, 1, 1);
+        let vdb = volume
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
         Self {
             volume: volume
                 .file_name()
@@ -388,12 +395,26 @@ impl Sidecar {
             box_min_m: grid.min_m.to_array(),
             box_max_m: grid.max_m.to_array(),
             cell_m: grid.cell_m().to_array(),
-            to_world: [
-                [size.x, 0.0, 0.0, min.x],
-                [0.0, size.y, 0.0, min.y],
-                [0.0, 0.0, size.z, min.z],
-                [0.0, 0.0, 0.0, 1.0],
-            ],
+            volume_space: if vdb {
+                "OpenVDB index space, placed in metres by the file's own transform"
+            } else {
+                "Mitsuba's unit cube [0, 1]^3"
+            },
+            to_world: if vdb {
+                [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ]
+            } else {
+                [
+                    [size.x, 0.0, 0.0, min.x],
+                    [0.0, size.y, 0.0, min.y],
+                    [0.0, 0.0, size.z, min.z],
+                    [0.0, 0.0, 0.0, 1.0],
+                ]
+            },
             max_extinction_per_m: values.iter().copied().fold(0.0, f32::max),
             albedo: ALBEDO,
             phase: [
