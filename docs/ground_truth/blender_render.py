@@ -2,7 +2,10 @@
 up as the README tells a Blender user to (runs in Blender's Python: the
 `bpy` wheel, `pip install bpy==4.5.15` into a Python 3.11 venv;
 blender_check.py calls it):
-- the volume object turned 90 degrees about x (our y up to Blender's z);
+- the volume object scaled by -1 along its own z and turned 90 degrees
+  about x: our x east, y up, z north (a left-handed labelling) become
+  Blender's x east, y north, z up, and its pictures are ours, not their
+  mirror image;
 - its material the phase function exactly ("lobes", the default): one
   Volume Scatter per Henyey-Greenstein lobe of the sidecar, whose
   density is the `density` attribute times the lobe's weight times the
@@ -14,10 +17,13 @@ blender_check.py calls it):
   Blender's equirectangular layout as the world;
 - every bounce kept (1024 volume bounces, no clamping, no denoising).
 
-Writes OUT.npy, linear RGB, its columns mirrored to our image's
-orientation (as compare.py does for Mitsuba's).
+Writes OUT.npy, linear RGB, in our image's orientation (compare.py
+mirrors Mitsuba's, whose world is right-handed); or, when OUT ends in
+.blend, saves the scene set up (nothing rendered) for Blender to open,
+with the sky image packed into it:
 
-    python render_blender.py VOLUME.vdb SKY.exr OUT WIDTH HEIGHT SPP [lobes|principled]
+    python blender_render.py VOLUME.vdb SKY.exr OUT WIDTH HEIGHT SPP [lobes|principled]
+    python blender_render.py clouds.vdb sky.exr clouds.blend 1280 720 256
 """
 import json
 import math
@@ -33,8 +39,10 @@ side = json.load(open(vdb[:-4] + ".json"))
 
 
 def to_blender(v):
-    """Our world (x east, y up, z north) turned 90 degrees about x."""
-    return Vector((v[0], -v[2], v[1]))
+    """Our world (x east, y up, z north: left-handed) as Blender's (x
+    east, y north, z up): y and z swapped, the volume object's 90 degree
+    turn about x after its scale of -1 along its own z."""
+    return Vector((v[0], v[2], v[1]))
 
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -60,6 +68,7 @@ scene.view_settings.view_transform = "Standard"
 bpy.ops.object.volume_import(filepath=vdb)
 vol = bpy.context.object
 vol.rotation_euler = (math.radians(90.0), 0.0, 0.0)
+vol.scale = (1.0, 1.0, -1.0)
 mat = bpy.data.materials.new("clouds")
 mat.use_nodes = True
 nodes, links = mat.node_tree.nodes, mat.node_tree.links
@@ -144,8 +153,8 @@ el = (v - 0.5) * math.pi  # asin(z), rows from the bottom
 X = np.cos(el)[:, None] * np.cos(phi)[None, :]
 Y = np.cos(el)[:, None] * np.sin(phi)[None, :]
 Z = np.sin(el)[:, None] * np.ones_like(phi)[None, :]
-# Back to our world: x = X, y = Z, z = -Y.
-x, y, z = X, Z, -Y
+# Back to our world: x = X, y = Z, z = Y.
+x, y, z = X, Z, Y
 um = (np.arctan2(x, -z) / (2 * math.pi)) % 1.0
 vm = np.arccos(np.clip(y, -1, 1)) / math.pi
 ii = np.clip((um * sw).astype(int), 0, sw - 1)
@@ -166,9 +175,15 @@ wo = wn.new("ShaderNodeOutputWorld")
 world.node_tree.links.new(env.outputs["Color"], bg.inputs["Color"])
 world.node_tree.links.new(bg.outputs["Background"], wo.inputs["Surface"])
 
+if out.endswith(".blend"):
+    img.pack()
+    vol.data.filepath = bpy.path.abspath(vdb)
+    bpy.ops.wm.save_as_mainfile(filepath=out)
+    sys.exit(0)
+
 scene.render.image_settings.file_format = "OPEN_EXR"
 scene.render.filepath = out + ".exr"
 bpy.ops.render.render(write_still=True)
 r = bpy.data.images.load(out + ".exr")
 a = np.array(r.pixels[:], dtype=np.float32).reshape(height, width, 4)[::-1, :, :3]
-np.save(out, a[:, ::-1])
+np.save(out, a)
