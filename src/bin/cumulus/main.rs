@@ -62,9 +62,9 @@ enum Command {
     #[command(allow_negative_numbers = true)]
     Stats(stats::StatsArgs),
     /// Write the density field the renderer marches (extinction per
-    /// metre on a grid over a box) as a Mitsuba 3 grid volume (.vol), with
-    /// the sun, camera, phase function and albedo in a JSON sidecar, for
-    /// offline renderers.
+    /// metre on a grid over a box) as a Mitsuba 3 grid volume (.vol) or an
+    /// OpenVDB fog volume (.vdb), with the sun, camera, phase function and
+    /// albedo in a JSON sidecar, for offline renderers.
     #[command(allow_negative_numbers = true)]
     Export(export::ExportArgs),
     /// Scene files.
