@@ -88,6 +88,7 @@ impl Mask {
 
 /// A leaf: its origin, active voxels and values (z fastest).
 struct Leaf {
+    origin: [i32; 3],
     mask: Mask,
     values: Vec<f32>,
 }
@@ -106,6 +107,7 @@ fn build_tree(grid: &Grid, values: &[f32]) -> Tree {
         for ly in (0..ny).step_by(side) {
             for lz in (0..nz).step_by(side) {
                 let mut leaf = Leaf {
+                    origin: [lx, ly, lz],
                     mask: Mask::new(LEAF_SIZE),
                     values: vec![0.0; LEAF_SIZE],
                 };
@@ -179,6 +181,45 @@ impl Bytes {
         self.u8(ALL_VALUES);
         self.f32s(v);
     }
+    /// An internal node's topology, `1 << (3 log2)` places: its child
+    /// mask (the places in `children`), no active tiles, and its tile
+    /// values, all the background 0.
+    fn internal_node(&mut self, children: impl Iterator<Item = usize>, log2: u32) {
+        let places = 1 << (3 * log2);
+        let mut mask = Mask::new(places);
+        children.for_each(|n| mask.set(n));
+        self.mask(&mask);
+        self.mask(&Mask::new(places));
+        self.u8(ALL_VALUES);
+        self.0.resize(self.0.len() + 4 * places, 0);
+    }
+}
+
+/// The tree's leaves, in the file's order (the topology's and the
+/// buffers').
+fn leaves(tree: &Tree) -> impl Iterator<Item = &Leaf> {
+    tree.values()
+        .flat_map(|lowers| lowers.values())
+        .flat_map(|leaves| leaves.values())
+}
+
+/// The active voxels' count and index bounds (inclusive), from the
+/// leaves; with none, the empty box OpenVDB writes (min `i32::MAX`, max
+/// `i32::MIN`).
+fn active_stats(tree: &Tree) -> (i64, [i32; 3], [i32; 3]) {
+    let (mut count, mut lo, mut hi) = (0, [i32::MAX; 3], [i32::MIN; 3]);
+    for leaf in leaves(tree) {
+        for n in (0..LEAF_SIZE).filter(|&n| leaf.mask.0[n / 64] >> (n % 64) & 1 == 1) {
+            count += 1;
+            let at = [n >> 6, (n >> 3) & 7, n & 7];
+            for a in 0..3 {
+                let v = leaf.origin[a] + at[a] as i32;
+                lo[a] = lo[a].min(v);
+                hi[a] = hi[a].max(v);
+            }
+        }
+    }
+    (count, lo, hi)
 }
 
 /// One metadata entry's value.
@@ -285,19 +326,7 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
         });
     }
     let tree = build_tree(grid, values);
-    let active: i64 = tree
-        .values()
-        .flat_map(|u| u.values())
-        .flat_map(|l| l.values())
-        .map(|leaf| {
-            leaf.mask
-                .0
-                .iter()
-                .map(|w| w.count_ones() as i64)
-                .sum::<i64>()
-        })
-        .sum();
-    let (lo, hi) = active_bounds(grid, values);
+    let (active, lo, hi) = active_stats(&tree);
     let mut b = Bytes::default();
     // The header.
     b.i64(MAGIC);
@@ -344,20 +373,11 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
     b.f32s(&[0.0]);
     b.u32(0);
     b.u32(tree.len() as u32);
-    let (upper_values, lower_values) = (vec![0.0; 1 << 15], vec![0.0; 1 << 12]);
     for (origin, lowers) in &tree {
         origin.iter().for_each(|&v| b.i32(v));
-        let mut children = Mask::new(1 << 15);
-        lowers.keys().for_each(|&n| children.set(n));
-        b.mask(&children);
-        b.mask(&Mask::new(1 << 15));
-        b.values(&upper_values);
+        b.internal_node(lowers.keys().copied(), 5);
         for leaves in lowers.values() {
-            let mut children = Mask::new(1 << 12);
-            leaves.keys().for_each(|&n| children.set(n));
-            b.mask(&children);
-            b.mask(&Mask::new(1 << 12));
-            b.values(&lower_values);
+            b.internal_node(leaves.keys().copied(), 4);
             for leaf in leaves.values() {
                 b.mask(&leaf.mask);
             }
@@ -365,11 +385,7 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
     }
     // The leaves' values, in the topology's order.
     let block_pos = b.0.len();
-    for leaf in tree
-        .values()
-        .flat_map(|u| u.values())
-        .flat_map(|l| l.values())
-    {
+    for leaf in leaves(&tree) {
         b.mask(&leaf.mask);
         b.values(&leaf.values);
     }
@@ -379,26 +395,6 @@ pub fn vdb_bytes(grid: &Grid, values: &[f32], quantity: &str) -> Result<Vec<u8>,
         b.0[at..at + 8].copy_from_slice(&(pos as i64).to_le_bytes());
     }
     Ok(b.0)
-}
-
-/// The index bounds of the active cells (σ_t > 0), inclusive; when none
-/// is, the empty box OpenVDB writes (min `i32::MAX`, max `i32::MIN`).
-fn active_bounds(grid: &Grid, values: &[f32]) -> ([i32; 3], [i32; 3]) {
-    let [nx, ny, nz] = grid.resolution;
-    let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                if values[grid.index(i, j, k)] > 0.0 {
-                    for (a, v) in [i, j, k].into_iter().enumerate() {
-                        lo[a] = lo[a].min(v as i32);
-                        hi[a] = hi[a].max(v as i32);
-                    }
-                }
-            }
-        }
-    }
-    (lo, hi)
 }
 
 /// Writes `values` on `grid` to `path` as an OpenVDB file
