@@ -52,6 +52,23 @@ fn render_scene(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     cumulus(&args)
 }
 
+/// `cumulus export` of fair weather after 900 simulated seconds into
+/// `out`, with `extra` arguments.
+fn export(out: &Path, extra: &[&str]) -> Output {
+    let scene = scene_path("fair_weather");
+    let mut args = vec![
+        "export",
+        "--scene",
+        scene.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--time-s",
+        "900",
+    ];
+    args.extend(extra);
+    cumulus(&args)
+}
+
 fn read_exr(path: &Path) -> (u32, u32, Vec<Vec3>) {
     let img = image::open(path).expect("an EXR image reads").to_rgb32f();
     let (w, h) = img.dimensions();
@@ -171,17 +188,7 @@ fn export_writes_the_density_the_renderer_marches() {
     let dir = tempfile::tempdir().expect("dir");
     let out = dir.path().join("clouds.vol");
     let scene = scene_path("fair_weather");
-    let o = cumulus(&[
-        "export",
-        "--scene",
-        scene.to_str().expect("utf-8"),
-        "--out",
-        out.to_str().expect("utf-8"),
-        "--cells",
-        "64",
-        "--time-s",
-        "900",
-    ]);
+    let o = export(&out, &["--cells", "64"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let (grid, values) = read_vol(&out).expect("the volume reads back");
 
@@ -264,21 +271,10 @@ fn python_with_openvdb() -> Option<&'static str> {
 #[test]
 fn export_writes_openvdb_files_openvdb_reads() {
     let dir = tempfile::tempdir().expect("dir");
-    let scene = scene_path("fair_weather");
     let (vol, vdb) = (dir.path().join("c.vol"), dir.path().join("c.vdb"));
     for out in [&vol, &vdb] {
-        let o = cumulus(&[
-            "export",
-            "--scene",
-            scene.to_str().expect("utf-8"),
-            "--out",
-            out.to_str().expect("utf-8"),
-            // 160 cells across: two of OpenVDB's 128-voxel nodes a side.
-            "--cells",
-            "160",
-            "--time-s",
-            "900",
-        ]);
+        // 160 cells across: two of OpenVDB's 128-voxel nodes a side.
+        let o = export(out, &["--cells", "160"]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
     let (grid, values) = read_vol(&vol).expect("vol");
@@ -327,19 +323,7 @@ fn export_writes_openvdb_files_openvdb_reads() {
     // And a box above the clouds: a grid with no active voxel.
     let (empty_vol, empty_vdb) = (dir.path().join("e.vol"), dir.path().join("e.vdb"));
     for out in [&empty_vol, &empty_vdb] {
-        let o = cumulus(&[
-            "export",
-            "--scene",
-            scene.to_str().expect("utf-8"),
-            "--out",
-            out.to_str().expect("utf-8"),
-            "--cells",
-            "8",
-            "--box",
-            "0,9000,0,100,9100,100",
-            "--time-s",
-            "900",
-        ]);
+        let o = export(out, &["--cells", "8", "--box", "0,9000,0,100,9100,100"]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/openvdb_reads.py");
