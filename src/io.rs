@@ -1,17 +1,89 @@
 //! Output files are written atomically: to a temporary file beside the
 //! target (`.NAME.PID.tmp`), then renamed over it, so a failure never
 //! leaves a partial file. [`remove_temp_files`] clears what an interrupted
-//! or killed run left.
+//! or killed run left. A symbolic link is written through (its target is
+//! replaced, the link kept), and what is not a regular file (a pipe, a
+//! FIFO, `/dev/stdout`, `/dev/null`) is written into as a stream
+//! ([`output_target`]).
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Where the bytes for output `path` go ([`output_target`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum OutputTarget {
+    /// A regular file, new or existing, written atomically: the path
+    /// with its symbolic links followed, so the link stays a link.
+    File(PathBuf),
+    /// Something that is not a regular file (a FIFO, a character device
+    /// such as `/dev/stdout` or `/dev/null`, a socket): written into as
+    /// it is. Renaming a file over it would replace it, and a reader on
+    /// the other end would get nothing.
+    Stream(PathBuf),
+}
+
+/// The most symbolic links followed from an output path (Linux's own
+/// limit): more is a loop.
+const MAX_LINKS: usize = 40;
+
+/// Where output `path` writes: the regular file its symbolic links lead
+/// to (existing or, for a dangling link, to be created), or a stream.
+/// A folder is an error (the caller names the path).
+pub fn output_target(path: &Path) -> std::io::Result<OutputTarget> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "is a folder, expected a file name",
+        )),
+        Ok(m) if m.is_file() => Ok(OutputTarget::File(std::fs::canonicalize(path)?)),
+        Ok(_) => Ok(OutputTarget::Stream(path.to_owned())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Ok(OutputTarget::File(follow_dangling_links(path)?))
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// `path` with its symbolic links followed one by one where the last
+/// one's target does not exist yet (or `path` itself when it is no link).
+fn follow_dangling_links(path: &Path) -> std::io::Result<PathBuf> {
+    let mut p = path.to_owned();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&p)?;
+                p = match p.parent() {
+                    Some(dir) if to.is_relative() => dir.join(to),
+                    _ => to,
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("more than {MAX_LINKS} symbolic links (a loop?)"),
+    ))
+}
 
 /// Writes the bytes `write` produces to `path` atomically. On error the
-/// temporary file is removed and `path` is untouched.
+/// temporary file is removed and `path` is untouched. Through a symbolic
+/// link the link's target is written; into a FIFO or a device, the bytes
+/// as a stream ([`output_target`]).
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    let path = match output_target(path)? {
+        OutputTarget::File(p) => p,
+        OutputTarget::Stream(p) => {
+            let file = std::fs::OpenOptions::new().write(true).open(&p)?;
+            let mut buf = std::io::BufWriter::new(file);
+            write(&mut buf)?;
+            return buf.flush();
+        }
+    };
+    let path = path.as_path();
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -104,6 +176,69 @@ pub fn write_exr_atomically(path: &Path, img: &image::Rgb32FImage) -> std::io::R
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_link_is_written_through_and_stays_a_link() {
+        let dir = tempfile::tempdir().expect("dir");
+        let real = dir.path().join("real.csv");
+        std::fs::write(&real, "old").expect("write");
+        let link = dir.path().join("link.csv");
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink("real.csv", &link).expect("link");
+            write_atomically(&link, |o| o.write_all(b"new")).expect("written");
+            assert_eq!(std::fs::read_to_string(&real).expect("read"), "new");
+            let m = std::fs::symlink_metadata(&link).expect("meta");
+            assert!(m.file_type().is_symlink(), "the link was replaced");
+            // A dangling link creates its target.
+            let dangling = dir.path().join("next.csv");
+            std::os::unix::fs::symlink("made.csv", &dangling).expect("link");
+            write_atomically(&dangling, |o| o.write_all(b"made")).expect("written");
+            let made = dir.path().join("made.csv");
+            assert_eq!(std::fs::read_to_string(made).expect("read"), "made");
+            assert!(
+                std::fs::symlink_metadata(&dangling)
+                    .expect("meta")
+                    .file_type()
+                    .is_symlink()
+            );
+            // A loop is refused.
+            let a = dir.path().join("a.csv");
+            std::os::unix::fs::symlink("a.csv", &a).expect("link");
+            let e = write_atomically(&a, |o| o.write_all(b"x")).expect_err("loop");
+            assert!(e.to_string().contains("symbolic links"), "{e}");
+        }
+        // A folder is refused by name.
+        let e = write_atomically(dir.path(), |o| o.write_all(b"x")).expect_err("folder");
+        assert!(e.to_string().contains("is a folder"), "{e}");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_or_a_device_is_written_into_not_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let null = Path::new("/dev/null");
+        if null.exists() {
+            write_atomically(null, |o| o.write_all(b"gone")).expect("written");
+            let m = std::fs::metadata(null).expect("meta");
+            assert!(m.file_type().is_char_device(), "/dev/null was replaced");
+        }
+        let dir = tempfile::tempdir().expect("dir");
+        let fifo = dir.path().join("curves.csv");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if !matches!(made, Ok(s) if s.success()) {
+            eprintln!("SKIPPED: no mkfifo");
+            return;
+        }
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read_to_string(fifo).expect("read"))
+        };
+        write_atomically(&fifo, |o| o.write_all(b"t,z\n0,1\n")).expect("written");
+        assert_eq!(reader.join().expect("reader"), "t,z\n0,1\n");
+        let m = std::fs::symlink_metadata(&fifo).expect("meta");
+        assert!(m.file_type().is_fifo(), "the FIFO was replaced by a file");
+    }
 
     #[test]
     fn temp_names_carry_their_process() {

@@ -316,3 +316,97 @@ pub fn spheroids(parcels: &Parcels, fill_full_condensed_fraction: f64) -> Vec<Sp
         })
         .collect()
 }
+
+/// What in the scene's view leaves its picture empty though every key is
+/// in its domain, one line each (the CLI prints them as warnings before
+/// it simulates): a camera under the ground, and a cloud band or a
+/// ground farther from the camera than `render.max_distance_m`, where
+/// every ray stops.
+pub fn view_warnings(scene: &Scene) -> Result<Vec<String>, SceneError> {
+    let atm = scene.atmosphere(None)?;
+    let band = scene.band(&atm);
+    let r = &scene.render;
+    let terrain = r.terrain.enabled.then(|| Heightfield::generate(&r.terrain));
+    let [x, y, z] = r.camera_position_m;
+    let ground = terrain.as_ref().map_or(0.0, |t| t.height_at(x, z));
+    Ok(warnings_for(
+        y,
+        ground,
+        (band.bottom_m as f32, band.top_m as f32),
+        r.max_distance_m,
+        terrain.is_some(),
+    ))
+}
+
+/// [`view_warnings`] for a camera `y` m high over ground at `ground` m,
+/// a cloud band from `band.0` to `band.1` m and rays of at most
+/// `max_distance` m.
+fn warnings_for(
+    y: f32,
+    ground: f32,
+    band: (f32, f32),
+    max_distance: f32,
+    terrain: bool,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    let what = if terrain { "terrain" } else { "flat ground" };
+    if y < ground {
+        out.push(format!(
+            "the camera (render.camera_position_m y = {y} m) is {:.0} m under the {what} \
+             (at {ground:.0} m): the picture is not what stands above it; raise its y",
+            ground - y
+        ));
+    }
+    let to_band = if y > band.1 {
+        y - band.1
+    } else {
+        (band.0 - y).max(0.0)
+    };
+    if to_band >= max_distance {
+        out.push(format!(
+            "the cloud band ({:.0}-{:.0} m) is {to_band:.0} m from the camera, beyond \
+             render.max_distance_m ({max_distance} m), where rays stop: no cloud can show; \
+             raise max_distance_m",
+            band.0, band.1
+        ));
+    }
+    if y - ground >= max_distance {
+        out.push(format!(
+            "the {what} is {:.0} m below the camera, beyond render.max_distance_m \
+             ({max_distance} m): it is not drawn; raise max_distance_m",
+            y - ground
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod view_tests {
+    use super::*;
+
+    #[test]
+    fn empty_pictures_are_foretold() {
+        let band = (600.0, 1600.0);
+        // A camera in the sky's usual places: nothing to say.
+        for y in [2.0, 100.0, 1000.0, 7000.0] {
+            assert!(
+                warnings_for(y, 0.0, band, 40_000.0, false).is_empty(),
+                "{y}"
+            );
+        }
+        // Under the ground (flat, or hills 300 m high under it).
+        let w = warnings_for(-500.0, 0.0, band, 40_000.0, false);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].contains("500 m under the flat ground"), "{w:?}");
+        let w = warnings_for(10.0, 300.0, band, 40_000.0, true);
+        assert!(w[0].contains("290 m under the terrain (at 300 m)"), "{w:?}");
+        // From 50 km up, rays of 40 km reach neither the band nor the
+        // ground (the review's flat blue picture).
+        let w = warnings_for(50_000.0, 0.0, band, 40_000.0, false);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w[0].contains("48400 m from the camera"), "{w:?}");
+        assert!(w[1].contains("50000 m below the camera"), "{w:?}");
+        // Longer rays reach both.
+        assert!(warnings_for(50_000.0, 0.0, band, 1e6, false).is_empty());
+    }
+}

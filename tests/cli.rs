@@ -310,6 +310,52 @@ fn profile_prints_lcl_and_writes_one_row_per_level() {
     assert_eq!(text.lines().count() - 1, levels);
 }
 
+/// Where there is no LCL the three lines say so alike: dry air printed an
+/// LCL of 0 hPa and 0 K beside a height of "none".
+#[test]
+fn profile_says_none_where_there_is_no_lcl() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let lines = |p: &std::path::Path| {
+        let o = cumulus(&["profile", "--sounding", p.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let dry = write(
+        "dry.csv",
+        "height_m,pressure_hPa,temperature_C,relative_humidity_pct\n0,1000,25,0\n500,950,20,0\n",
+    );
+    let out = lines(&dry);
+    for key in ["lcl_pressure_hPa", "lcl_temperature_K", "lcl_height_m"] {
+        assert!(out.contains(&format!("{key}=none (")), "{out}");
+    }
+    assert!(out.contains("never saturates"), "{out}");
+    // Moist air whose LCL lies above a short sounding: its pressure and
+    // temperature (as MetPy's `lcl` gives them), no height, and why.
+    let short = write(
+        "short.csv",
+        "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,25,15\n100,988.5,24,14.8\n",
+    );
+    let out = lines(&short);
+    let p: f64 = out
+        .lines()
+        .find_map(|l| l.strip_prefix("lcl_pressure_hPa="))
+        .expect("pressure")
+        .parse()
+        .expect("a number");
+    assert!((850.0..950.0).contains(&p), "{out}");
+    assert!(
+        out.contains(
+            "lcl_height_m=none (the LCL lies above the sounding's top, 988.5 hPa at 100 m)"
+        ),
+        "{out}"
+    );
+}
+
 #[test]
 fn scene_check_accepts_shipped_scenes_and_rejects_bad_ones() {
     for s in ["bomex", "fair_weather", "strong_inversion"] {
@@ -881,6 +927,20 @@ fn shipped_scenes_work_outside_the_repository() {
     let o = render("scenes/mine.toml");
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("cannot read scene"), "{}", stderr(&o));
+    // `scene check` reads a scene as the other commands do (it said "No
+    // such file" for the name `render` takes).
+    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args(["scene", "check", "scenes/fair_weather.toml"])
+        .current_dir(dir.path())
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("using the built-in copy"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains(": ok ("));
 }
 
 #[test]

@@ -56,7 +56,7 @@ impl AtmosphereSection {
             checks.push(Check {
                 key: "atmosphere.sounding".into(),
                 ok: false,
-                expected: "either a sounding or [atmosphere.parametric], not both",
+                expected: "either a sounding or [atmosphere.parametric], not both".into(),
                 value: "both given".into(),
             });
         }

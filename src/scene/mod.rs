@@ -260,6 +260,7 @@ impl Scene {
             Some(p) => Some(p.to_owned()),
             None => a.sounding_path(self.source.as_deref()),
         };
+        let from_sounding = sounding_path.is_some();
         let atm = match sounding_path {
             Some(p) => {
                 let s = Sounding::load(&p, surface).map_err(|e| match e {
@@ -274,10 +275,71 @@ impl Scene {
             }
             None => Atmosphere::from_parametric(&a.parametric.unwrap_or_default()),
         };
-        Ok(match a.inversion_base_m {
+        let atm = match a.inversion_base_m {
             Some(z) => atm.with_inversion_base(z),
             None => atm,
-        })
+        };
+        self.check_within(&atm, from_sounding)?;
+        Ok(atm)
+    }
+
+    /// The parcels' release and the cloud band lie within the atmosphere
+    /// `atm`, below its top, where its table ends and the parcels stop:
+    /// parcels released above it, or a band above it, simulated quietly
+    /// into a sky without clouds (a sounding that ends at 100 m, a
+    /// parametric `top_m` under the inversion). The error names the key
+    /// the user wrote where there is one, else the atmosphere's
+    /// (`from_sounding`: a sounding's, the scene's or `--sounding`'s).
+    fn check_within(&self, atm: &Atmosphere, from_sounding: bool) -> Result<(), SceneError> {
+        let top = atm.top_m();
+        let (atm_key, atm_top) = if from_sounding {
+            ("atmosphere.sounding", "the sounding's highest level")
+        } else {
+            (
+                "atmosphere.parametric.top_m",
+                "`atmosphere.parametric.top_m`",
+            )
+        };
+        if self.physics.release_height_m >= top {
+            return Err(self.invalid(
+                "physics.release_height_m",
+                format!(
+                    "is {}, expected below the atmosphere's top at {top} m ({atm_top})",
+                    self.physics.release_height_m
+                ),
+            ));
+        }
+        let band = self.band(atm);
+        let bottom_key = match self.projection.band_bottom_m {
+            Some(_) => "projection.band_bottom_m",
+            None => atm_key,
+        };
+        if band.bottom_m >= top {
+            return Err(self.invalid(
+                bottom_key,
+                format!(
+                    "the cloud band starts at {} m, at or above the atmosphere's top at {top} m \
+                     ({atm_top}): the parcels cannot rise into it",
+                    band.bottom_m
+                ),
+            ));
+        }
+        if band.top_m > top {
+            let key = match (self.projection.band_top_m, self.atmosphere.inversion_base_m) {
+                (Some(_), _) => "projection.band_top_m",
+                (None, Some(_)) => "atmosphere.inversion_base_m",
+                (None, None) => atm_key,
+            };
+            return Err(self.invalid(
+                key,
+                format!(
+                    "the cloud band reaches {} m, above the atmosphere's top at {top} m \
+                     ({atm_top}), where the parcels stop",
+                    band.top_m
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The cloud band: the scene's values, else the surface air's LCL to the
@@ -338,6 +400,51 @@ mod tests {
         let s = Scene::parse("[render]\nrenderer = \"spheroids\"\n", Path::new("s.toml"))
             .expect("spheroids over parcels");
         assert_eq!(s.render.renderer, RenderMethod::Spheroids);
+    }
+
+    #[test]
+    fn release_and_band_above_the_atmospheres_top_are_refused() {
+        let atm = |text: &str| {
+            Scene::parse(text, Path::new("s.toml"))
+                .expect("valid keys")
+                .atmosphere(None)
+        };
+        // Parcels released above the table's 8000 m top sat there.
+        let e = atm("[physics]\nrelease_height_m = 1e5\n").expect_err("released above");
+        assert_eq!(
+            e.to_string(),
+            "s.toml:2: `physics.release_height_m`: is 100000, expected below the \
+             atmosphere's top at 8000 m (`atmosphere.parametric.top_m`)"
+        );
+        // A top under the inversion: the band (to the inversion) is cut.
+        let e = atm("[atmosphere.parametric]\ntop_m = 1000\n").expect_err("band above the top");
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("s.toml:2: `atmosphere.parametric.top_m`: the cloud band reaches"),
+            "{msg}"
+        );
+        // A band the user set is blamed on its own key.
+        let e = atm("[projection]\nband_bottom_m = 700\nband_top_m = 9000\n")
+            .expect_err("band_top above the top");
+        assert!(
+            e.to_string()
+                .starts_with("s.toml:3: `projection.band_top_m`: the cloud band reaches 9000 m"),
+            "{e}"
+        );
+        // The shipped default is within.
+        atm("").expect("default scene");
+    }
+
+    #[test]
+    fn a_kernel_too_wide_for_the_domain_names_the_parcels_radius() {
+        let e = Scene::parse("[physics]\nradius_m = 1e5\n", Path::new("s.toml"))
+            .expect_err("kernel wider than the domain");
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("s.toml:2: `physics.radius_m`: is 100000, expected at most"),
+            "{msg}"
+        );
+        assert!(!msg.contains("`physics.sph.smoothing_radii`"), "{msg}");
     }
 
     #[test]

@@ -11,7 +11,7 @@ pub struct Check {
     pub key: Cow<'static, str>,
     pub ok: bool,
     /// The domain, as the error message states it.
-    pub expected: &'static str,
+    pub expected: Cow<'static, str>,
     /// The value, as the error message states it.
     pub value: String,
 }
@@ -21,13 +21,13 @@ impl Check {
     pub fn new(
         key: impl Into<Cow<'static, str>>,
         ok: bool,
-        expected: &'static str,
+        expected: impl Into<Cow<'static, str>>,
         value: f64,
     ) -> Self {
         Self {
             key: key.into(),
             ok,
-            expected,
+            expected: expected.into(),
             value: shortest(value),
         }
     }

@@ -113,13 +113,31 @@ impl PhysicsConfig {
                 1e9,
                 "1e-3..=1e9 s",
             ),
-            Check::new(
+            r(
                 "physics.sph.smoothing_radii",
-                super::check::finite_in(p.sph.smoothing_radii, 1e-3, 100.0)
-                    && (!p.sph.enabled
-                        || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m),
-                "1e-3..=100, with smoothing_radii * radius_m <= domain_size_m / 2",
                 p.sph.smoothing_radii,
+                1e-3,
+                100.0,
+                "1e-3..=100",
+            ),
+            // The SPH kernel's reach must fit in half the domain. Said of
+            // the parcels' radius, with the two other keys' values: the
+            // error once named `smoothing_radii` (a default the user
+            // never wrote) when `radius_m` or `domain_size_m` was set.
+            Check::new(
+                "physics.radius_m",
+                !p.sph.enabled
+                    || !p.sph.smoothing_radii.is_finite()
+                    || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m,
+                format!(
+                    "at most domain_size_m / (2 * sph.smoothing_radii) = {} / (2 * {}) = {} m \
+                     with SPH on: the kernel's reach, smoothing_radii radii, fits in half \
+                     the domain (a larger domain_size_m or fewer smoothing_radii allow more)",
+                    p.domain_size_m,
+                    p.sph.smoothing_radii,
+                    0.5 * p.domain_size_m / p.sph.smoothing_radii
+                ),
+                p.radius_m,
             ),
             r(
                 "physics.sph.sound_speed_mps",

@@ -10,7 +10,24 @@ use std::path::{Path, PathBuf};
 
 use super::constants::{G, R_D, ZERO_CELSIUS_K};
 use super::sounding_formats::{Format, detect, igra2_to_csv, sharppy_to_csv, wyoming_to_csv};
-use super::thermo::{mixing_ratio_from_dewpoint, saturation_mixing_ratio};
+use super::thermo::{
+    mixing_ratio_from_dewpoint, saturation_mixing_ratio, saturation_vapour_pressure,
+};
+
+/// The most relative humidity a sounding's level may have, as a fraction:
+/// the parametric profile's bound on `surface_relative_humidity` (1.2).
+/// Air in nature is supersaturated by well under a percent, and a
+/// radiosonde's humidity errs by a few; beyond a fifth the row is a
+/// mistake (until 2026-12-06: 150 %, or a dewpoint 10 K above the
+/// temperature, some 180 % at 25 °C).
+pub const RH_MAX: f64 = 1.2;
+
+/// The relative humidity over liquid water of a dewpoint `td_c` at
+/// temperature `t_c` (°C), as a fraction.
+fn dewpoint_humidity(td_c: f64, t_c: f64) -> f64 {
+    saturation_vapour_pressure(td_c + ZERO_CELSIUS_K)
+        / saturation_vapour_pressure(t_c + ZERO_CELSIUS_K)
+}
 
 /// What went wrong reading a sounding; every message names the file and,
 /// where there is one, the line and column.
@@ -187,16 +204,24 @@ impl Sounding {
                 ));
             }
             match humidity {
-                Humidity::DewpointC if hum > t + 10.0 || hum < -150.0 => {
+                Humidity::DewpointC if hum < -150.0 || dewpoint_humidity(hum, t) > RH_MAX => {
                     return Err(err(
                         line,
-                        format!("`dewpoint_C` is {hum}, expected -150..=temperature_C + 10"),
+                        format!(
+                            "`dewpoint_C` is {hum}, expected -150 or more, with at most \
+                             {:.0} % relative humidity at `temperature_C` {t} (it gives {:.0} %)",
+                            RH_MAX * 100.0,
+                            dewpoint_humidity(hum, t) * 100.0
+                        ),
                     ));
                 }
-                Humidity::RelativeHumidityPct if !(0.0..=150.0).contains(&hum) => {
+                Humidity::RelativeHumidityPct if !(0.0..=RH_MAX * 100.0).contains(&hum) => {
                     return Err(err(
                         line,
-                        format!("`relative_humidity_pct` is {hum}, expected 0..=150"),
+                        format!(
+                            "`relative_humidity_pct` is {hum}, expected 0..={:.0}",
+                            RH_MAX * 100.0
+                        ),
                     ));
                 }
                 _ => {}
@@ -380,6 +405,31 @@ mod tests {
             msg.contains("s.csv:2:") && msg.contains("temperature_C"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn supersaturation_beyond_a_fifth_is_refused_as_the_parametric_profile_does() {
+        let h = "height_m,pressure_hPa,temperature_C,";
+        // A dewpoint 5 K above the temperature (136 % at 25 °C), and 150 %.
+        let e = parse(&format!("{h}dewpoint_C\n0,1000,25,30\n500,950,20,15\n"))
+            .expect_err("supersaturated");
+        let msg = e.to_string();
+        assert!(msg.starts_with("s.csv:2: `dewpoint_C` is 30"), "{msg}");
+        assert!(
+            msg.contains("at most 120 %") && msg.contains("gives 13"),
+            "{msg}"
+        );
+        let e = parse(&format!(
+            "{h}relative_humidity_pct\n0,1000,25,150\n500,950,20,50\n"
+        ))
+        .expect_err("supersaturated");
+        assert!(e.to_string().contains("expected 0..=120"), "{e}");
+        // A little supersaturation, as radiosondes report in cloud, loads.
+        parse(&format!("{h}dewpoint_C\n0,1000,20,21\n500,950,17,9\n")).expect("106 %");
+        parse(&format!(
+            "{h}relative_humidity_pct\n0,1000,20,110\n500,950,17,9\n"
+        ))
+        .expect("110 %");
     }
 
     #[test]

@@ -75,10 +75,27 @@ fn to_csv(lines: &[Option<[f64; 4]>]) -> Result<String, LineError> {
         ));
     }
     let mut out = String::with_capacity(lines.len() * 40);
+    let mut below: Option<(f64, usize)> = None;
     for (k, l) in lines.iter().enumerate() {
         match (k, l) {
             (0, _) => out.push_str(HEADER),
             (_, Some([p, h, t, td])) => {
+                // Said here in the original's own terms: the CSV reader
+                // would blame `height_m` for a height the file never had
+                // (this level's less the lowest one's).
+                if let Some((h0, k0)) = below
+                    && *h <= h0
+                {
+                    return Err((
+                        k as u64 + 1,
+                        format!(
+                            "HGHT is {h} m, not above the previous level's {h0} m (line {}): \
+                             levels must rise",
+                            k0 + 1
+                        ),
+                    ));
+                }
+                below = Some((*h, k));
                 out.push_str(&format!("{},{p},{t},{td}", h - ground));
             }
             (_, None) => out.push('#'),
@@ -231,6 +248,18 @@ Station information and sounding indices\n";
         assert_eq!(lines[5], "0,1012,27.2,23.2");
         assert_eq!(lines[6], "106,1000,26.4,22.4");
         assert_eq!(lines[7], "#");
+    }
+
+    #[test]
+    fn levels_out_of_order_are_named_in_the_originals_terms() {
+        let t = "%TITLE%\n KEY\n%RAW%\n 1000.00, 500.00, 26, 22.37, 90, 5\n 1015, 5, 25, 20, 90, 5\n%END%\n";
+        let (line, why) = sharppy_to_csv(t).expect_err("falling levels");
+        assert_eq!(line, 5, "{why}");
+        assert!(
+            why.contains("HGHT is 5 m") && why.contains("500 m (line 4)"),
+            "{why}"
+        );
+        assert!(!why.contains("height_m"), "{why}");
     }
 
     #[test]

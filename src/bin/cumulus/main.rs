@@ -105,7 +105,9 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene {
             command: SceneCommand::Check { file },
         } => {
-            let scene = Scene::load(&file)?;
+            // As every other command reads it: outside the repository a
+            // shipped scene's name checks its built-in copy, said so.
+            let scene = load_scene(&file)?;
             let atm = scene.atmosphere(None)?;
             let band = scene.band(&atm);
             println!(
@@ -249,9 +251,17 @@ fn guard_output_dir(dir: &Path) {
     }
 }
 
-/// [`guard_output_dir`] for the folder of the output file `path`.
+/// [`guard_output_dir`] for the folder the output file `path` is written
+/// in: the folder of the file its symbolic links lead to (where the
+/// temporary file goes), none for a FIFO or a device (written as a
+/// stream, no temporary file).
 fn guard_output_file(path: &Path) {
-    match path.parent() {
+    let file = match cumulus::io::output_target(path) {
+        Ok(cumulus::io::OutputTarget::File(p)) => p,
+        Ok(cumulus::io::OutputTarget::Stream(_)) => return,
+        Err(_) => path.to_owned(),
+    };
+    match file.parent() {
         Some(d) if !d.as_os_str().is_empty() => guard_output_dir(d),
         _ => guard_output_dir(Path::new(".")),
     }

@@ -50,11 +50,28 @@ pub fn run(a: ProfileArgs) -> Result<()> {
         AdiabatArg::Reversible => Adiabat::Reversible,
     };
     let prof = lift_sounding(&s, adiabat);
-    println!("lcl_pressure_hPa={:.3}", prof.lcl.pressure_pa / 100.0);
-    println!("lcl_temperature_K={:.3}", prof.lcl.temperature_k);
-    match prof.lcl_height_m {
-        Some(z) => println!("lcl_height_m={z:.1}"),
-        None => println!("lcl_height_m=none (the parcel does not saturate within the sounding)"),
+    if prof.lcl.pressure_pa > 0.0 {
+        // MetPy's `lcl` too gives the pressure and temperature where the
+        // lifted air saturates, within the sounding or above its top.
+        println!("lcl_pressure_hPa={:.3}", prof.lcl.pressure_pa / 100.0);
+        println!("lcl_temperature_K={:.3}", prof.lcl.temperature_k);
+    } else {
+        // Air without vapour never saturates: no LCL at all (it printed 0
+        // hPa and 0 K).
+        let why = "(the lowest level's air holds no water vapour: it never saturates)";
+        println!("lcl_pressure_hPa=none {why}");
+        println!("lcl_temperature_K=none {why}");
+    }
+    match (prof.lcl_height_m, prof.rows.last()) {
+        (Some(z), _) => println!("lcl_height_m={z:.1}"),
+        (None, Some(top)) if prof.lcl.pressure_pa > 0.0 => println!(
+            "lcl_height_m=none (the LCL lies above the sounding's top, {:.1} hPa at {:.0} m)",
+            top.pressure_pa / 100.0,
+            top.height_m
+        ),
+        (None, _) => {
+            println!("lcl_height_m=none (the parcel does not saturate within the sounding)")
+        }
     }
     if let Some(out) = &a.out {
         crate::guard_output_file(out);

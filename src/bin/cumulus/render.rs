@@ -128,6 +128,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
             r.steps = steps;
         }
     })?;
+    for w in cumulus::prepare::view_warnings(&scene)? {
+        eprintln!("warning: {}: {w}", a.scene.display());
+    }
     let mut picture = None;
     let r = &scene.render;
     let factor = r.exposure_factor();
