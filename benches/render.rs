@@ -1,9 +1,12 @@
 //! Cloud-map generation, P's spread, the light volume's build and its
-//! three steps, and CPU rendering of a 320x240 frame.
+//! three steps, CPU rendering of a 320x240 frame, and the endless
+//! database's distances between its volumes (beside the doubles they
+//! were summed in until 2026-12-06).
 //!
 //! `cargo bench --bench render`
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use cumulus::endless::distances;
 use cumulus::prepare::Prepared;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::light_volume::{
@@ -65,9 +68,54 @@ fn render(c: &mut Criterion) {
     });
 }
 
+/// The distances as they were summed until 2026-12-06: every pair both
+/// ways round, in doubles, rows in parallel (the reference for [`distances`]' speed).
+fn distances_in_doubles(volumes: &[Vec<u8>]) -> Vec<f64> {
+    use rayon::prelude::*;
+    let n = volumes.len();
+    let mut d = vec![0.0; n * n];
+    d.par_chunks_mut(n.max(1)).enumerate().for_each(|(k, row)| {
+        for (l, out) in row.iter_mut().enumerate() {
+            if l != k {
+                *out = volumes[k]
+                    .iter()
+                    .zip(&volumes[l])
+                    .map(|(a, b)| {
+                        let x = (*a as f64 - *b as f64) / 255.0;
+                        x * x
+                    })
+                    .sum();
+            }
+        }
+    });
+    d
+}
+
+fn endless(c: &mut Criterion) {
+    // 24 volumes of 128x16x128 (the shipped endless scene's size), bytes
+    // as the sampler writes them: a smooth field, mostly empty.
+    let volumes: Vec<Vec<u8>> = (0..24u32)
+        .map(|v| {
+            (0..128 * 16 * 128u32)
+                .map(|i| ((i.wrapping_mul(2_654_435_761) ^ v.wrapping_mul(40_503)) >> 26) as u8 * 4)
+                .collect()
+        })
+        .collect();
+    assert_eq!(distances(&volumes)[1], {
+        let d = distances_in_doubles(&volumes)[1];
+        (d * 65025.0).round() / 65025.0
+    });
+    c.bench_function("endless_distances_24x128x16x128", |b| {
+        b.iter(|| distances(&volumes))
+    });
+    c.bench_function("endless_distances_24x128x16x128_doubles_both_ways", |b| {
+        b.iter(|| distances_in_doubles(&volumes))
+    });
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10).measurement_time(std::time::Duration::from_secs(5));
-    targets = render
+    targets = render, endless
 }
 criterion_main!(benches);

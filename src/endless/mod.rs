@@ -71,7 +71,9 @@ pub struct Database {
 
 impl Database {
     /// Simulates `scene` and samples `cfg.volumes` volumes over its
-    /// domain and band (`progress` after each physics frame and volume).
+    /// domain and band (`progress` after each physics frame and volume,
+    /// then after each volume compared with the others: `cfg.volumes`
+    /// more).
     pub fn build(
         scene: &Scene,
         cfg: &EndlessConfig,
@@ -116,7 +118,7 @@ impl Database {
             return Err(scene.invalid("simulation.endless.cells", e));
         }
         let (origin, extent, full) = placed.unwrap_or((Vec3::ZERO, Vec3::ONE, 0.0));
-        let distance = distances(&volumes);
+        let distance = distances_with(&volumes, &mut progress_cell);
         Ok(Self {
             dims: [nx as usize, ny as usize, nz as usize],
             volumes,
@@ -212,22 +214,84 @@ impl Database {
 
 /// Every pair's summed squared difference (densities as bytes / 255).
 pub fn distances(volumes: &[Vec<u8>]) -> Vec<f64> {
+    distances_with(volumes, || {})
+}
+
+/// [`distances`], calling `progress` after each volume's row. Each pair
+/// is compared once (the matrix is symmetric) in integers, exact, and
+/// scaled once: 256 volumes of 512x8x512 took 199 s in doubles, both
+/// ways round, with no word after the progress bar's 100 %.
+pub fn distances_with(volumes: &[Vec<u8>], mut progress: impl FnMut()) -> Vec<f64> {
     use rayon::prelude::*;
     let n = volumes.len();
     let mut d = vec![0.0; n * n];
-    d.par_chunks_mut(n.max(1)).enumerate().for_each(|(k, row)| {
-        for (l, out) in row.iter_mut().enumerate() {
-            if l != k {
-                *out = volumes[k]
+    for k in 0..n {
+        let row: Vec<f64> = (k + 1..n)
+            .into_par_iter()
+            .map(|l| squared_difference(&volumes[k], &volumes[l]) as f64 / (255.0 * 255.0))
+            .collect();
+        for (l, v) in (k + 1..n).zip(row) {
+            d[k * n + l] = v;
+            d[l * n + k] = v;
+        }
+        progress();
+    }
+    d
+}
+
+/// `Σ (a - b)²` over two volumes' bytes, exact: in blocks whose sums fit
+/// a `u32` (4096 · 255² < 2³²), which the compiler vectorises.
+fn squared_difference(a: &[u8], b: &[u8]) -> u64 {
+    a.chunks(4096)
+        .zip(b.chunks(4096))
+        .map(|(x, y)| {
+            x.iter()
+                .zip(y)
+                .map(|(p, q)| {
+                    let t = u32::from(p.abs_diff(*q));
+                    t * t
+                })
+                .sum::<u32>() as u64
+        })
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distances_are_each_pairs_squared_difference_once() {
+        // Volumes long enough for several of the sum's 4096-byte blocks,
+        // full of every byte's extremes.
+        let volumes: Vec<Vec<u8>> = (0..5u32)
+            .map(|v| {
+                (0..10_000u32)
+                    .map(|i| ((i.wrapping_mul(2_654_435_761) ^ v.wrapping_mul(40_503)) >> 7) as u8)
+                    .collect()
+            })
+            .collect();
+        let mut rows = 0;
+        let d = distances_with(&volumes, || rows += 1);
+        assert_eq!(rows, 5);
+        let n = volumes.len();
+        for k in 0..n {
+            assert_eq!(d[k * n + k], 0.0);
+            for l in 0..n {
+                let direct: f64 = volumes[k]
                     .iter()
                     .zip(&volumes[l])
-                    .map(|(a, b)| {
-                        let x = (*a as f64 - *b as f64) / 255.0;
-                        x * x
-                    })
+                    .map(|(a, b)| ((*a as f64 - *b as f64) / 255.0).powi(2))
                     .sum();
+                assert!(
+                    (d[k * n + l] - direct).abs() <= 1e-9 * direct.max(1.0),
+                    "{k} {l}"
+                );
+                assert_eq!(d[k * n + l], d[l * n + k]);
             }
         }
-    });
-    d
+        // All 0 against all 255: 255² per byte, exact past a u32's range.
+        let big = [vec![0u8; 70_000], vec![255u8; 70_000]];
+        assert_eq!(distances(&big)[1], 70_000.0);
+    }
 }

@@ -441,10 +441,13 @@ fn render_endless(
             "--time-frames and --quality-report are for the cloud map; `cumulus bench --methods` times the volumes"
         );
     }
+    // The physics' frames, then one step per volume compared with the
+    // others (the player's distances).
     let frames = Prepared::frames(scene)
         + (cfg.volumes.saturating_sub(1) as f64 * cfg.interval_s / scene.physics.dt_s).ceil()
-            as u64;
-    let bar = progress_bar(frames, "simulating and sampling the volumes");
+            as u64
+        + cfg.volumes as u64;
+    let bar = progress_bar(frames, "simulating, sampling and comparing the volumes");
     let (db, source) = Database::load_or_build(scene, cfg, || bar.inc(1))?;
     bar.finish_and_clear();
     let whence = match source {
