@@ -61,6 +61,47 @@ pub(super) fn key_at_line(text: &str, line: usize) -> Option<String> {
     None
 }
 
+/// A TOML type error in a user's words: serde's "expected u32", "expected
+/// f64" and "expected struct RenderSettings" name Rust's types; a scene's
+/// author wrote a number or a table.
+pub(super) fn plain_types(message: &str) -> String {
+    const TYPES: [(&str, &str); 12] = [
+        ("expected u8", "expected a whole number 0..=255"),
+        ("expected u16", "expected a whole number 0..=65535"),
+        ("expected u32", "expected a whole number, 0 or more"),
+        ("expected u64", "expected a whole number, 0 or more"),
+        ("expected usize", "expected a whole number, 0 or more"),
+        ("expected i32", "expected a whole number"),
+        ("expected i64", "expected a whole number"),
+        ("expected f32", "expected a number"),
+        ("expected f64", "expected a number"),
+        ("expected a sequence", "expected an array, [a, b, ...]"),
+        ("expected a string", "expected a string in quotes"),
+        ("expected a boolean", "expected true or false"),
+    ];
+    let mut m = message.to_owned();
+    for (rust, plain) in TYPES {
+        if let Some(at) = m.find(rust) {
+            let end = at + rust.len();
+            // Whole words only: "expected u32" and not "expected u32x".
+            if !m[end..].starts_with(|c: char| c.is_alphanumeric() || c == '_') {
+                m.replace_range(at..end, plain);
+            }
+        }
+    }
+    if let Some(at) = m.find("expected struct ") {
+        let rest = &m[at + "expected struct ".len()..];
+        let len = rest
+            .find(|c: char| !c.is_alphanumeric() && c != '_')
+            .unwrap_or(rest.len());
+        m.replace_range(
+            at..at + "expected struct ".len() + len,
+            "expected a table of keys",
+        );
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 
 pub use atmosphere::AtmosphereSection;
 pub use locate::locate_key;
-use locate::{key_at_line, line_col};
+use locate::{key_at_line, line_col, plain_types};
 pub use projection::ProjectionSection;
 pub use render::{RenderMethod, RenderSettings};
 pub use simulation::{EndlessConfig, Method, SimulationSection};
@@ -127,7 +127,7 @@ impl Scene {
     pub fn parse(text: &str, path: &Path) -> Result<Self, SceneError> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
-            let message = e.message().trim();
+            let message = plain_types(e.message().trim());
             // A type error names the key it is about (an unknown key's
             // message names the key already).
             let message = match key_at_line(text, line) {
@@ -445,6 +445,26 @@ mod tests {
             "{msg}"
         );
         assert!(!msg.contains("`physics.sph.smoothing_radii`"), "{msg}");
+    }
+
+    #[test]
+    fn type_errors_speak_of_numbers_and_tables_not_rust_types() {
+        for (text, said) in [
+            (
+                "[render]\nwidth = \"wide\"\n",
+                "expected a whole number, 0 or more",
+            ),
+            ("[physics]\ndt_s = \"x\"\n", "expected a number"),
+            ("render = 5\n", "expected a table of keys"),
+            ("[render]\ntsaa = 3\n", "expected true or false"),
+        ] {
+            let e = Scene::parse(text, Path::new("s.toml")).expect_err("wrong type");
+            let msg = e.to_string();
+            assert!(msg.ends_with(said), "{msg}");
+            for rust in ["u32", "f64", "struct", "RenderSettings"] {
+                assert!(!msg.contains(rust), "{msg}");
+            }
+        }
     }
 
     #[test]

@@ -52,8 +52,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         max_frame_s: a.max_frame_s.unwrap_or(if a.quick { 2.0 } else { 20.0 }),
         methods_only: a.methods,
     };
-    std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    crate::create_output_folder(&a.out)?;
     crate::guard_output_dir(&a.out);
     let report = gpu_bench::run(&ctx, &scene, &o, |line| eprintln!("{line}"))?;
     gpu_bench::write(&report, &a.out)?;

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use cumulus::report::convergence;
 
@@ -36,8 +36,7 @@ pub fn run(a: ConvergenceArgs) -> Result<()> {
         );
     }
     let atm = scene.atmosphere(None)?;
-    std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    crate::create_output_folder(&a.out)?;
     crate::guard_output_dir(&a.out);
     let dts = convergence::DEFAULT_DTS_S;
     let bar = progress_bar(dts.len() as u64 + 1, "convergence");

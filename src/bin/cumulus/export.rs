@@ -36,7 +36,14 @@ pub struct ExportArgs {
     cells: u32,
     /// The box, metres: x0,y0,z0,x1,y1,z1 (x east, y up, z north).
     /// Default: the simulated domain across the cloud band.
-    #[arg(long, value_delimiter = ',', value_name = "X0,Y0,Z0,X1,Y1,Z1")]
+    // A box starting at a negative x reads as one (`--box -500,...`), not
+    // as an unknown flag.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "X0,Y0,Z0,X1,Y1,Z1",
+        allow_hyphen_values = true
+    )]
     r#box: Option<Vec<f32>>,
     /// Also write the renderer's sky (no sun disk) as a 512x256
     /// latitude-longitude OpenEXR map, laid out for Mitsuba 3's envmap.
@@ -125,9 +132,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
     }
     let cloudy = values.iter().filter(|&&v| v > 0.0).count();
     let [nx, ny, nz] = grid.resolution;
+    let cell = grid.cell_m().min_element();
     println!(
-        "{nx}x{ny}x{nz} cells of {:.1} m over {} to {} m; {:.1} % cloudy, max extinction {:.4} /m",
-        grid.cell_m().min_element(),
+        "{nx}x{ny}x{nz} cells of {} m over {} to {} m; {:.1} % cloudy, max extinction {:.4} /m",
+        // A thin box's cells are under a decimetre ("0.0 m" before).
+        if cell >= 1.0 {
+            format!("{cell:.1}")
+        } else {
+            format!("{cell:.2e}")
+        },
         min,
         max,
         100.0 * cloudy as f64 / values.len() as f64,

@@ -251,6 +251,19 @@ fn guard_output_dir(dir: &Path) {
     }
 }
 
+/// Makes the output folder `dir` (and its parents); an existing file
+/// there is refused by name (the OS said only "File exists").
+fn create_output_folder(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!(
+            "{}: is a file, expected a folder to write the outputs in",
+            dir.display()
+        );
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the folder", dir.display()))
+}
+
 /// [`guard_output_dir`] for the folder the output file `path` is written
 /// in: the folder of the file its symbolic links lead to (where the
 /// temporary file goes), none for a FIFO or a device (written as a

@@ -172,6 +172,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if gpu.is_none() && a.time_frames.is_some() {
         bail!("--time-frames needs the GPU backend (--backend gpu)");
     }
+    if gpu.is_none() && a.frames.is_some() {
+        // Not an error: with --backend auto the same command runs on a
+        // machine with a GPU, where --frames counts.
+        eprintln!(
+            "warning: --frames is for the GPU backend; the CPU renderer averages \
+             render.cpu_offsets jittered frames instead"
+        );
+    }
     if a.single_scattering
         && (gpu.is_some()
             || scene.simulation.method == Method::Endless
@@ -195,8 +203,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     let frame = prepared.frame(r, quality);
     if let Some(dir) = &a.quality_report {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+        crate::create_output_folder(dir)?;
         guard_output_dir(dir);
         let (w, h) = (r.width.min(320), r.height.min(240));
         let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");

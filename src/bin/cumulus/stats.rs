@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 
 use cumulus::prepare::Prepared;
 use cumulus::report::field_stats::{self, column_field};
@@ -61,8 +61,7 @@ pub fn run(a: StatsArgs) -> Result<()> {
             s.render.time_s = t;
         }
     })?;
-    std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    crate::create_output_folder(&a.out)?;
     crate::guard_output_dir(&a.out);
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
