@@ -310,6 +310,27 @@ fn profile_prints_lcl_and_writes_one_row_per_level() {
     assert_eq!(text.lines().count() - 1, levels);
 }
 
+/// Printing into a pipe whose reader is gone ends the run quietly, as Unix
+/// tools do (`println!` panicked: "failed printing to stdout: Broken pipe").
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_on_stdout_ends_the_run_without_a_panic() {
+    use std::process::Stdio;
+    let scene = root().join("scenes/fair_weather.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args(["scene", "check", scene.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    // The reader goes before the scene is read and checked.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("waits");
+    let err = stderr(&o);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(o.status.code(), Some(101), "{err}");
+}
+
 /// Where there is no LCL the three lines say so alike: dry air printed an
 /// LCL of 0 hPa and 0 K beside a height of "none".
 #[test]

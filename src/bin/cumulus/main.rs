@@ -86,6 +86,7 @@ enum SceneCommand {
 
 fn main() {
     quiet_wayland_probe();
+    default_sigpipe();
     install_interrupt_handler();
     if let Err(e) = run(Cli::parse()) {
         eprintln!("error: {e:#}");
@@ -214,6 +215,21 @@ fn quiet_wayland_probe() {
         // SAFETY: single-threaded here (the first statement of main); no
         // other code reads or writes the environment concurrently.
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
+}
+
+/// Rust starts a program with SIGPIPE ignored, so printing into a pipe
+/// whose reader is gone (`cumulus profile ... | head -1`) fails, and
+/// `println!` panics on that. Back to the default, the run ends quietly,
+/// as `cat` or `grep` would; an output file being written is a temporary
+/// one until it is renamed into place, and the next run into its folder
+/// removes it.
+fn default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: single-threaded here (main's first statements); setting a
+    // signal's disposition to SIG_DFL has no other effect on this process.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
