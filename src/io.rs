@@ -16,9 +16,11 @@ pub enum OutputTarget {
     /// with its symbolic links followed, so the link stays a link.
     File(PathBuf),
     /// Something that is not a regular file (a FIFO, a character device
-    /// such as `/dev/stdout` or `/dev/null`, a socket): written into as
-    /// it is. Renaming a file over it would replace it, and a reader on
-    /// the other end would get nothing.
+    /// such as `/dev/null`, a socket), or this process's own standard
+    /// output or error, whatever it was redirected to (`/dev/stdout` into
+    /// a log): written into as it is, appended to. Renaming a file over
+    /// it would replace it: a FIFO's reader would get nothing, a log
+    /// what it held.
     Stream(PathBuf),
 }
 
@@ -35,12 +37,43 @@ pub fn output_target(path: &Path) -> std::io::Result<OutputTarget> {
             std::io::ErrorKind::InvalidInput,
             "is a folder, expected a file name",
         )),
-        Ok(m) if m.is_file() => Ok(OutputTarget::File(std::fs::canonicalize(path)?)),
+        Ok(m) if m.is_file() && !is_standard_stream(path, &m) => {
+            Ok(OutputTarget::File(std::fs::canonicalize(path)?))
+        }
         Ok(_) => Ok(OutputTarget::Stream(path.to_owned())),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             Ok(OutputTarget::File(follow_dangling_links(path)?))
         }
         Err(e) => Err(e),
+    }
+}
+
+/// Whether `path` (its metadata `m`) is this process's standard output
+/// or error: a path under `/dev` or `/proc` (`/dev/stdout`,
+/// `/dev/fd/1`, `/proc/self/fd/2`), or the very file either was
+/// redirected to. Through `/dev/stdout` redirected into a file, a
+/// renamed temporary file would have replaced that file, with what the
+/// run had printed to it before.
+fn is_standard_stream(path: &Path, m: &std::fs::Metadata) -> bool {
+    if path.starts_with("/dev") || path.starts_with("/proc") {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        use std::os::unix::fs::MetadataExt;
+        let same = |fd: std::os::fd::BorrowedFd<'_>| {
+            fd.try_clone_to_owned()
+                .ok()
+                .and_then(|fd| std::fs::File::from(fd).metadata().ok())
+                .is_some_and(|s| s.dev() == m.dev() && s.ino() == m.ino())
+        };
+        same(std::io::stdout().as_fd()) || same(std::io::stderr().as_fd())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = m;
+        false
     }
 }
 
@@ -77,7 +110,7 @@ pub fn write_atomically(
     let path = match output_target(path)? {
         OutputTarget::File(p) => p,
         OutputTarget::Stream(p) => {
-            let file = std::fs::OpenOptions::new().write(true).open(&p)?;
+            let file = std::fs::OpenOptions::new().append(true).open(&p)?;
             let mut buf = std::io::BufWriter::new(file);
             write(&mut buf)?;
             return buf.flush();
@@ -180,11 +213,11 @@ mod tests {
     #[test]
     fn a_link_is_written_through_and_stays_a_link() {
         let dir = tempfile::tempdir().expect("dir");
-        let real = dir.path().join("real.csv");
-        std::fs::write(&real, "old").expect("write");
-        let link = dir.path().join("link.csv");
         #[cfg(unix)]
         {
+            let real = dir.path().join("real.csv");
+            std::fs::write(&real, "old").expect("write");
+            let link = dir.path().join("link.csv");
             std::os::unix::fs::symlink("real.csv", &link).expect("link");
             write_atomically(&link, |o| o.write_all(b"new")).expect("written");
             assert_eq!(std::fs::read_to_string(&real).expect("read"), "new");
@@ -230,14 +263,40 @@ mod tests {
             eprintln!("SKIPPED: no mkfifo");
             return;
         }
-        let reader = {
+        let (sent, got) = std::sync::mpsc::channel();
+        {
             let fifo = fifo.clone();
-            std::thread::spawn(move || std::fs::read_to_string(fifo).expect("read"))
-        };
+            std::thread::spawn(move || sent.send(std::fs::read_to_string(fifo).expect("read")));
+        }
         write_atomically(&fifo, |o| o.write_all(b"t,z\n0,1\n")).expect("written");
-        assert_eq!(reader.join().expect("reader"), "t,z\n0,1\n");
+        // A FIFO replaced by a file leaves the reader waiting for ever:
+        // fail, not hang.
+        let read = got.recv_timeout(std::time::Duration::from_secs(20));
+        assert_eq!(read.as_deref(), Ok("t,z\n0,1\n"));
         let m = std::fs::symlink_metadata(&fifo).expect("meta");
         assert!(m.file_type().is_fifo(), "the FIFO was replaced by a file");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn the_standard_streams_are_written_into_whatever_they_lead_to() {
+        // /dev/stdout redirected into a log is a regular file, but the
+        // run's own: appended to, not replaced.
+        for p in ["/dev/stdout", "/dev/fd/2", "/proc/self/fd/1"] {
+            let p = Path::new(p);
+            if let Ok(m) = std::fs::metadata(p) {
+                assert!(is_standard_stream(p, &m), "{}", p.display());
+            }
+        }
+        let dir = tempfile::tempdir().expect("dir");
+        let plain = dir.path().join("plain.csv");
+        std::fs::write(&plain, "x").expect("write");
+        let m = std::fs::metadata(&plain).expect("meta");
+        assert!(!is_standard_stream(&plain, &m));
+        assert_eq!(
+            output_target(&plain).expect("target"),
+            OutputTarget::File(std::fs::canonicalize(&plain).expect("canonical"))
+        );
     }
 
     #[test]

@@ -331,6 +331,35 @@ fn a_closed_pipe_on_stdout_ends_the_run_without_a_panic() {
     assert_ne!(o.status.code(), Some(101), "{err}");
 }
 
+/// `--out /dev/stdout` with the output redirected into a log appends to
+/// the log: the temporary file renamed over it replaced the log and
+/// what the run had printed into it.
+#[cfg(unix)]
+#[test]
+fn out_to_dev_stdout_appends_to_a_redirected_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("log.txt");
+    std::fs::write(&log, "kept\n").unwrap();
+    let file = std::fs::OpenOptions::new().append(true).open(&log).unwrap();
+    let snd = root().join("scenes/bomex_sounding.csv");
+    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
+        .args([
+            "profile",
+            "--sounding",
+            snd.to_str().unwrap(),
+            "--out",
+            "/dev/stdout",
+        ])
+        .stdout(file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.starts_with("kept\nlcl_pressure_hPa="), "{text}");
+    assert!(text.contains("\nheight_m,pressure_hPa,"), "{text}");
+    assert!(std::fs::metadata(&log).unwrap().is_file());
+}
+
 /// Where there is no LCL the three lines say so alike: dry air printed an
 /// LCL of 0 hPa and 0 K beside a height of "none".
 #[test]

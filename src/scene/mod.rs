@@ -309,6 +309,37 @@ impl Scene {
                 ),
             ));
         }
+        // A parametric inversion at or above the parametric top is not in
+        // the table at all: the band would quietly fall back to its
+        // default. Blamed on whichever of the two keys the file sets.
+        let written = |k| {
+            self.text
+                .as_deref()
+                .and_then(|t| locate_key(t, k))
+                .is_some()
+        };
+        if let (false, None, Some(pp)) = (
+            from_sounding,
+            self.atmosphere.inversion_base_m,
+            self.atmosphere.parametric,
+        ) && pp.inversion_base_m >= pp.top_m
+        {
+            let key = if written("atmosphere.parametric.top_m")
+                || !written("atmosphere.parametric.inversion_base_m")
+            {
+                "atmosphere.parametric.top_m"
+            } else {
+                "atmosphere.parametric.inversion_base_m"
+            };
+            return Err(self.invalid(
+                key,
+                format!(
+                    "the inversion (inversion_base_m {} m) lies at or above the atmosphere's \
+                     top (top_m {} m): lower the inversion or raise the top",
+                    pp.inversion_base_m, pp.top_m
+                ),
+            ));
+        }
         let band = self.band(atm);
         let bottom_key = match self.projection.band_bottom_m {
             Some(_) => "projection.band_bottom_m",
@@ -325,6 +356,10 @@ impl Scene {
             ));
         }
         if band.top_m > top {
+            // The key that set the band's top ([`Self::band`]): the
+            // band's own, else the inversion's (the scene's override, the
+            // parametric profile's, a sounding's own); the default top
+            // is held within the atmosphere.
             let key = match (self.projection.band_top_m, self.atmosphere.inversion_base_m) {
                 (Some(_), _) => "projection.band_top_m",
                 (None, Some(_)) => "atmosphere.inversion_base_m",
@@ -343,7 +378,8 @@ impl Scene {
     }
 
     /// The cloud band: the scene's values, else the surface air's LCL to the
-    /// inversion base (LCL + 1500 m without an inversion).
+    /// inversion base (LCL + 1500 m without an inversion, at most to the
+    /// atmosphere's top: a short sounding's band ends with it).
     pub fn band(&self, atm: &Atmosphere) -> Band {
         let lcl = surface_lcl_height(atm).unwrap_or(500.0);
         let bottom = self.projection.band_bottom_m.unwrap_or(lcl);
@@ -351,7 +387,7 @@ impl Scene {
             .projection
             .band_top_m
             .or(atm.inversion_base_m().filter(|&z| z > bottom + 50.0))
-            .unwrap_or(bottom + 1500.0);
+            .unwrap_or((bottom + 1500.0).min(atm.top_m()));
         Band {
             bottom_m: bottom,
             top_m: top.max(bottom + 1.0),
@@ -410,21 +446,41 @@ mod tests {
                 .atmosphere(None)
         };
         // Parcels released above the table's 8000 m top sat there.
-        let e = atm("[physics]\nrelease_height_m = 1e5\n").expect_err("released above");
+        let e = atm("[physics]\nrelease_height_m = 1e5\n")
+            .map(|_| ())
+            .expect_err("released above");
         assert_eq!(
             e.to_string(),
             "s.toml:2: `physics.release_height_m`: is 100000, expected below the \
              atmosphere's top at 8000 m (`atmosphere.parametric.top_m`)"
         );
-        // A top under the inversion: the band (to the inversion) is cut.
-        let e = atm("[atmosphere.parametric]\ntop_m = 1000\n").expect_err("band above the top");
-        let msg = e.to_string();
+        // A top under the (default) inversion, which the table then lacks:
+        // blamed on the key the file wrote.
+        let e = atm("[atmosphere.parametric]\ntop_m = 1000\n")
+            .map(|_| ())
+            .expect_err("top under the inversion");
         assert!(
-            msg.starts_with("s.toml:2: `atmosphere.parametric.top_m`: the cloud band reaches"),
-            "{msg}"
+            e.to_string().starts_with(
+                "s.toml:2: `atmosphere.parametric.top_m`: the inversion (inversion_base_m 1500 m)"
+            ),
+            "{e}"
         );
+        let e = atm("[atmosphere.parametric]\ninversion_base_m = 9000\n")
+            .map(|_| ())
+            .expect_err("inversion above the top");
+        assert!(
+            e.to_string()
+                .starts_with("s.toml:2: `atmosphere.parametric.inversion_base_m`: the inversion"),
+            "{e}"
+        );
+        // A band starting above a low top (the LCL is above it).
+        let e = atm("[atmosphere.parametric]\ntop_m = 300\ninversion_base_m = 200\n")
+            .map(|_| ())
+            .expect_err("band above the top");
+        assert!(e.to_string().contains("the cloud band starts at"), "{e}");
         // A band the user set is blamed on its own key.
         let e = atm("[projection]\nband_bottom_m = 700\nband_top_m = 9000\n")
+            .map(|_| ())
             .expect_err("band_top above the top");
         assert!(
             e.to_string()
@@ -433,6 +489,22 @@ mod tests {
         );
         // The shipped default is within.
         atm("").expect("default scene");
+        // A short sounding with no inversion: the default band (LCL +
+        // 1500 m) ends at its top rather than being refused.
+        let dir = tempfile::tempdir().expect("dir");
+        let mut rows = String::from("height_m,pressure_hPa,temperature_C,dewpoint_C\n");
+        for k in 0..=20 {
+            let z = 100.0 * k as f64;
+            rows += &format!("{z},,{},{}\n", 25.0 - 0.0065 * z, 10.0 - 0.002 * z);
+        }
+        std::fs::write(dir.path().join("short.csv"), rows).expect("write");
+        let path = dir.path().join("s.toml");
+        let scene = Scene::parse("[atmosphere]\nsounding = \"short.csv\"\n", &path).expect("keys");
+        let a = scene
+            .atmosphere(None)
+            .expect("a band within a 2 km sounding");
+        let band = scene.band(&a);
+        assert!(band.bottom_m > 500.0 && band.top_m == a.top_m(), "{band:?}");
     }
 
     #[test]

@@ -130,7 +130,7 @@ impl PhysicsConfig {
                     || !p.sph.smoothing_radii.is_finite()
                     || p.sph.smoothing_radii * p.radius_m <= 0.5 * p.domain_size_m,
                 format!(
-                    "at most domain_size_m / (2 * sph.smoothing_radii) = {} / (2 * {}) = {} m \
+                    "at most domain_size_m / (2 * sph.smoothing_radii) = {} / (2 * {}) = {:.1} m \
                      with SPH on: the kernel's reach, smoothing_radii radii, fits in half \
                      the domain (a larger domain_size_m or fewer smoothing_radii allow more)",
                     p.domain_size_m,

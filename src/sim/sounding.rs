@@ -22,6 +22,13 @@ use super::thermo::{
 /// temperature, some 180 % at 25 °C).
 pub const RH_MAX: f64 = 1.2;
 
+/// How far a dewpoint may lie above its temperature whatever the
+/// humidity it gives, K: in the cold upper air a kelvin is a large step
+/// of relative humidity over water (2 K at -60 °C is some 130 %), and a
+/// frost point written as a dewpoint in an ice-supersaturated layer is
+/// ordinary radiosonde data.
+pub const DEWPOINT_EXCESS_MAX_K: f64 = 2.0;
+
 /// The relative humidity over liquid water of a dewpoint `td_c` at
 /// temperature `t_c` (°C), as a fraction.
 fn dewpoint_humidity(td_c: f64, t_c: f64) -> f64 {
@@ -204,12 +211,17 @@ impl Sounding {
                 ));
             }
             match humidity {
-                Humidity::DewpointC if hum < -150.0 || dewpoint_humidity(hum, t) > RH_MAX => {
+                Humidity::DewpointC
+                    if hum < -150.0
+                        || (hum > t + DEWPOINT_EXCESS_MAX_K
+                            && dewpoint_humidity(hum, t) > RH_MAX) =>
+                {
                     return Err(err(
                         line,
                         format!(
-                            "`dewpoint_C` is {hum}, expected -150 or more, with at most \
-                             {:.0} % relative humidity at `temperature_C` {t} (it gives {:.0} %)",
+                            "`dewpoint_C` is {hum}, expected -150 or more, and at most \
+                             {DEWPOINT_EXCESS_MAX_K} K above `temperature_C` {t} or \
+                             {:.0} % relative humidity (it gives {:.0} %)",
                             RH_MAX * 100.0,
                             dewpoint_humidity(hum, t) * 100.0
                         ),
@@ -416,7 +428,7 @@ mod tests {
         let msg = e.to_string();
         assert!(msg.starts_with("s.csv:2: `dewpoint_C` is 30"), "{msg}");
         assert!(
-            msg.contains("at most 120 %") && msg.contains("gives 13"),
+            msg.contains("120 % relative humidity") && msg.contains("gives 13"),
             "{msg}"
         );
         let e = parse(&format!(
@@ -426,6 +438,8 @@ mod tests {
         assert!(e.to_string().contains("expected 0..=120"), "{e}");
         // A little supersaturation, as radiosondes report in cloud, loads.
         parse(&format!("{h}dewpoint_C\n0,1000,20,21\n500,950,17,9\n")).expect("106 %");
+        // A dewpoint 2 K above a -60 °C temperature (over 120 % there).
+        parse(&format!("{h}dewpoint_C\n0,1000,20,10\n9000,300,-60,-58\n")).expect("cold air");
         parse(&format!(
             "{h}relative_humidity_pct\n0,1000,20,110\n500,950,17,9\n"
         ))

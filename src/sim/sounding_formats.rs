@@ -59,8 +59,8 @@ pub type LineError = (u64, String);
 
 /// The rows of `(pressure_hPa, height_m_asl, temperature_C, dewpoint_C)`
 /// per line of the original (`None`: not a level) as our CSV, heights above
-/// the lowest level.
-fn to_csv(lines: &[Option<[f64; 4]>]) -> Result<String, LineError> {
+/// the lowest level; `height` names the original's height column in errors.
+fn to_csv(lines: &[Option<[f64; 4]>], height: &str) -> Result<String, LineError> {
     let ground = lines.iter().flatten().map(|r| r[1]).next();
     let Some(ground) = ground else {
         return Err((
@@ -89,7 +89,7 @@ fn to_csv(lines: &[Option<[f64; 4]>]) -> Result<String, LineError> {
                     return Err((
                         k as u64 + 1,
                         format!(
-                            "HGHT is {h} m, not above the previous level's {h0} m (line {}): \
+                            "{height} is {h} m, not above the previous level's {h0} m (line {}): \
                              levels must rise",
                             k0 + 1
                         ),
@@ -152,7 +152,7 @@ pub fn wyoming_to_csv(text: &str) -> Result<String, LineError> {
             rows[k] = Some([p, h, t, td]);
         }
     }
-    to_csv(&rows)
+    to_csv(&rows, "HGHT")
 }
 
 /// A SHARPpy `%RAW%` file as our CSV. Levels with a missing (-9999)
@@ -191,7 +191,7 @@ pub fn sharppy_to_csv(text: &str) -> Result<String, LineError> {
             _ => {}
         }
     }
-    to_csv(&rows)
+    to_csv(&rows, "HGHT")
 }
 
 /// The first sounding of an IGRA2 sounding-data file as our CSV. Levels
@@ -222,7 +222,7 @@ pub fn igra2_to_csv(text: &str) -> Result<String, LineError> {
             rows[k] = Some([p / 100.0, z, t / 10.0, (t - dpd) / 10.0]);
         }
     }
-    to_csv(&rows)
+    to_csv(&rows, "GPH")
 }
 
 #[cfg(test)]

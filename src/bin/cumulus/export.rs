@@ -136,7 +136,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     println!(
         "{nx}x{ny}x{nz} cells of {} m over {} to {} m; {:.1} % cloudy, max extinction {:.4} /m",
         // A thin box's cells are under a decimetre ("0.0 m" before).
-        if cell >= 1.0 {
+        if cell >= 0.1 {
             format!("{cell:.1}")
         } else {
             format!("{cell:.2e}")

@@ -222,8 +222,8 @@ fn quiet_wayland_probe() {
 /// whose reader is gone (`cumulus profile ... | head -1`) fails, and
 /// `println!` panics on that. Back to the default, the run ends quietly,
 /// as `cat` or `grep` would; an output file being written is a temporary
-/// one until it is renamed into place, and the next run into its folder
-/// removes it.
+/// one until it is renamed into place (where `/proc` lists the processes,
+/// Linux, the next run into its folder removes it).
 fn default_sigpipe() {
     #[cfg(unix)]
     // SAFETY: single-threaded here (main's first statements); setting a
@@ -312,6 +312,25 @@ fn check_output_file(path: &Path) -> Result<()> {
             "{}: is a directory, expected a file to write",
             path.display()
         );
+    }
+    // Where the bytes land: through a symbolic link, its target's folder
+    // must exist (found only after the simulation, before); a stream
+    // needs no folder.
+    let target = match cumulus::io::output_target(path) {
+        Ok(cumulus::io::OutputTarget::Stream(_)) => return Ok(()),
+        Ok(cumulus::io::OutputTarget::File(p)) => p,
+        Err(e) => bail!("{}: cannot write: {e}", path.display()),
+    };
+    if target != path {
+        let dir = target.parent().unwrap_or(Path::new("."));
+        if !dir.as_os_str().is_empty() && !dir.is_dir() {
+            bail!(
+                "{}: cannot write: it links to {}, whose folder {} does not exist",
+                path.display(),
+                target.display(),
+                dir.display()
+            );
+        }
     }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
