@@ -497,7 +497,10 @@ mod tests {
             let z = 100.0 * k as f64;
             rows += &format!("{z},,{},{}\n", 25.0 - 0.0065 * z, 10.0 - 0.002 * z);
         }
-        std::fs::write(dir.path().join("short.csv"), rows).expect("write");
+        crate::io::write_atomically(&dir.path().join("short.csv"), |o| {
+            o.write_all(rows.as_bytes())
+        })
+        .expect("write");
         let path = dir.path().join("s.toml");
         let scene = Scene::parse("[atmosphere]\nsounding = \"short.csv\"\n", &path).expect("keys");
         let a = scene
