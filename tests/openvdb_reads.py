@@ -44,7 +44,7 @@ def main(vdb_path, vol_path):
     lo_ijk, hi_ijk = g.evalActiveVoxelBoundingBox()
     assert tuple(m["file_bbox_min"]) == tuple(lo_ijk), (m, lo_ijk)
     assert tuple(m["file_bbox_max"]) == tuple(hi_ijk), (m, hi_ijk)
-    assert m["file_compression"] == "none" and m["is_saved_as_half_float"] is False, m
+    assert m["file_compression"] == "zip" and m["is_saved_as_half_float"] is False, m
     cell = (hi - lo) / np.array([nx, ny, nz])
     for ijk in [(0, 0, 0), (nx - 1, ny - 1, nz - 1), (nx // 2, ny // 3, nz // 5)]:
         world = np.array(g.transform.indexToWorld(ijk))

@@ -1,5 +1,6 @@
 //! Reading back the OpenVDB files [`super::write_vdb`] writes: float
-//! grids of OpenVDB's standard 5-4-3 tree, uncompressed, with no active
+//! grids of OpenVDB's standard 5-4-3 tree, uncompressed or zipped
+//! (`COMPRESS_ZIP`, no active-mask compression), with no active
 //! tiles (what [`super::vdb_bytes`] makes). Anything else is refused with
 //! the reason, not guessed at: this is the writer's check, not a general
 //! VDB reader (OpenVDB's own library is, and `tests/exports.rs` reads the
@@ -31,6 +32,8 @@ struct Reader<'a> {
     path: &'a Path,
     bytes: Vec<u8>,
     at: usize,
+    /// The grid's values are zip-framed ([`super::COMPRESS_ZIP`]).
+    zip: bool,
 }
 
 impl Reader<'_> {
@@ -98,17 +101,57 @@ impl Reader<'_> {
             .collect()
     }
     /// A node's `count` values: the metadata byte must say all of them
-    /// follow (what an uncompressed grid has).
+    /// follow (no active-mask compression); raw, or zip-framed.
     fn values(&mut self, count: usize) -> Result<Vec<f32>, VolumeError> {
         let meta = self.u8()?;
         if meta != super::ALL_VALUES {
             return Err(self.bad(format!(
-                "node metadata {meta} at byte {}, expected {} (all values, uncompressed)",
+                "node metadata {meta} at byte {}, expected {} (all values)",
                 self.at - 1,
                 super::ALL_VALUES
             )));
         }
-        (0..count).map(|_| self.f32()).collect()
+        if !self.zip {
+            return (0..count).map(|_| self.f32()).collect();
+        }
+        let bytes = 4 * count;
+        let at = self.at;
+        let n = self.i64()?;
+        let raw = if n <= 0 {
+            if n.unsigned_abs() != bytes as u64 {
+                return Err(self.bad(format!(
+                    "a raw chunk of {} bytes at byte {at}, expected {bytes}",
+                    n.unsigned_abs()
+                )));
+            }
+            self.take(bytes)?.to_vec()
+        } else {
+            let len = usize::try_from(n).unwrap_or(usize::MAX);
+            let stream = self.take(len)?;
+            // At most one byte past the expected size, so a damaged
+            // stream cannot inflate without bound.
+            let mut out = Vec::with_capacity(bytes);
+            let read = std::io::Read::read_to_end(
+                &mut std::io::Read::take(flate2::read::ZlibDecoder::new(stream), bytes as u64 + 1),
+                &mut out,
+            );
+            match read {
+                Ok(_) if out.len() == bytes => out,
+                Ok(_) => {
+                    return Err(self.bad(format!(
+                        "the zip chunk at byte {at} holds {} bytes, expected {bytes}",
+                        out.len()
+                    )));
+                }
+                Err(e) => {
+                    return Err(self.bad(format!("the zip chunk at byte {at} is damaged: {e}")));
+                }
+            }
+        };
+        Ok(raw
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect())
     }
     /// A metadata map: the string entries by name (others skipped).
     fn meta(&mut self) -> Result<Vec<(String, String)>, VolumeError> {
@@ -149,7 +192,12 @@ pub fn read_vdb(path: &Path) -> Result<VdbGrid, VolumeError> {
         path: path.to_owned(),
         source,
     })?;
-    let mut r = Reader { path, bytes, at: 0 };
+    let mut r = Reader {
+        path,
+        bytes,
+        at: 0,
+        zip: false,
+    };
     if r.i64()? != MAGIC {
         return Err(r.bad("no OpenVDB magic number at its start"));
     }
@@ -188,11 +236,13 @@ pub fn read_vdb(path: &Path) -> Result<VdbGrid, VolumeError> {
         }
         r.seek(grid_pos)?;
         let compression = r.u32()?;
-        if compression != 0 {
+        if compression != 0 && compression != super::COMPRESS_ZIP {
             return Err(r.bad(format!(
-                "grid {name} is compressed (flags {compression}); only uncompressed grids are read"
+                "grid {name} is compressed (flags {compression}); only uncompressed and \
+                 zip-compressed grids are read"
             )));
         }
+        r.zip = compression == super::COMPRESS_ZIP;
         let class = r
             .meta()?
             .into_iter()

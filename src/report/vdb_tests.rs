@@ -202,3 +202,86 @@ fn child_offsets_are_openvdbs() {
     assert_eq!(child_offset(128, 0, 0, 5, LOWER_TOTAL), 1024);
     assert_eq!(child_offset(4096 + 128, 0, 0, 5, LOWER_TOTAL), 1024);
 }
+
+/// Node values are zip-framed as OpenVDB's `zipToStream` frames them:
+/// a zlib stream behind its length where that is smaller (empty tiles,
+/// smooth clouds), raw behind the negated length where it is not
+/// (noise); both read back bit for bit, and a cloud's file is well under
+/// its uncompressed size.
+#[test]
+fn node_values_are_zipped_or_kept_raw_and_read_back() {
+    use std::io::Read;
+    let mut b = Bytes::default();
+    b.zipped(&[0u8; 4096]);
+    let n = i64::from_le_bytes(b.0[..8].try_into().expect("8 bytes"));
+    assert!(n > 0 && (n as usize) < 100, "zeros zip to {n} bytes");
+    let mut out = Vec::new();
+    flate2::read::ZlibDecoder::new(&b.0[8..])
+        .read_to_end(&mut out)
+        .expect("a zlib stream");
+    assert_eq!(out, vec![0u8; 4096]);
+    // Bytes zlib cannot shrink are written raw.
+    let mut x = 0x2545_f491_4f6c_dd1d_u64;
+    let noise: Vec<u8> = (0..4096)
+        .map(|_| {
+            // xorshift64: bytes with no pattern for zlib to find.
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 32) as u8
+        })
+        .collect();
+    let mut b = Bytes::default();
+    b.zipped(&noise);
+    assert_eq!(
+        i64::from_le_bytes(b.0[..8].try_into().expect("8 bytes")),
+        -4096
+    );
+    assert_eq!(&b.0[8..], &noise[..]);
+
+    // A whole grid: a smooth cloud (zipped leaves) beside a leaf of noise
+    // (kept raw) round-trips, and the file is a fraction of the raw one.
+    let g = Grid::new([64, 16, 64], Vec3::ZERO, Vec3::new(640.0, 160.0, 640.0)).expect("grid");
+    let mut values = vec![0.0; g.len()];
+    for k in 0..64 {
+        for j in 0..16 {
+            for i in 0..64 {
+                let r2 = ((i as f32 - 32.0).powi(2) + (k as f32 - 32.0).powi(2)) / 400.0;
+                values[g.index(i, j, k)] = (0.05 * (1.0 - r2)).max(0.0);
+            }
+        }
+    }
+    // The first leaf (8x8x8 cells at the corner, outside the cloud):
+    // noise, which zlib cannot shrink.
+    for k in 0..8 {
+        for j in 0..8 {
+            for i in 0..8 {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                // Any positive finite float: 31 random bits of 32.
+                values[g.index(i, j, k)] = f32::from_bits(((x >> 33) as u32 & 0x7f7f_ffff) | 1);
+            }
+        }
+    }
+    let bytes = vdb_bytes(&g, &values, "sigma_t").expect("bytes");
+    // The noise leaf went raw: its 2048 bytes behind -2048.
+    let raw_mark = (-2048_i64).to_le_bytes();
+    assert!(bytes.windows(8).any(|w| w == raw_mark), "no raw chunk");
+    let leaves = values.chunks(512).count();
+    assert!(
+        bytes.len() < leaves * 2048 / 2,
+        "{} bytes for {leaves} leaves' 2 KiB each",
+        bytes.len()
+    );
+    let dir = tempfile::tempdir().expect("dir");
+    let path = dir.path().join("z.vdb");
+    write_vdb(&path, &g, &values, "sigma_t").expect("write");
+    let back = read_vdb(&path).expect("read");
+    let active = values.iter().filter(|v| **v > 0.0).count();
+    assert_eq!(back.voxels.len(), active);
+    for (ijk, v) in back.voxels {
+        let [i, j, k] = ijk.map(|x| x as u32);
+        assert_eq!(v, values[g.index(i, j, k)], "{ijk:?}");
+    }
+}
