@@ -402,3 +402,108 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
         "{dark} of {clear} clear pixels are black"
     );
 }
+
+/// A depth buffer of `format`, `samples` and `usage`, cleared to the far
+/// value of [`engine_view`]'s reversed Z, 0.
+fn depth_of(
+    ctx: &GpuContext,
+    format: wgpu::TextureFormat,
+    samples: u32,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    let t = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("app.depth"),
+        size: wgpu::Extent3d {
+            width: W,
+            height: H,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: usage | wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let view = t.create_view(&Default::default());
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("app.clear"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0.0),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: format.has_stencil_aspect().then_some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0),
+                store: wgpu::StoreOp::Store,
+            }),
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    ctx.queue.submit([enc.finish()]);
+    t
+}
+
+/// An engine's depth buffer as engines make them: a depth-stencil format
+/// (its default view has both aspects) gives the same clouds as a depth
+/// one, and what the passes cannot bind (a multisampled or unbindable
+/// buffer), or a target of another size than the renderer's, is a
+/// `RenderError` naming it, not a panic in wgpu's validation or a
+/// picture read at the wrong pixels.
+#[test]
+fn engine_depth_buffers_are_bound_or_refused_by_name() {
+    let Some(ctx) = gpu() else { return };
+    let (sc, p) = prepared();
+    let mut c = renderer(&ctx, &sc, &p);
+    let view = engine_view(&sc);
+    let bind = wgpu::TextureUsages::TEXTURE_BINDING;
+    let plain = depth_of(&ctx, wgpu::TextureFormat::Depth32Float, 1, bind);
+    let stencil = depth_of(&ctx, wgpu::TextureFormat::Depth24PlusStencil8, 1, bind);
+    let a = clouds_only(&ctx, &mut c, Some(&plain), &view);
+    let b = clouds_only(&ctx, &mut c, Some(&stencil), &view);
+    assert!(opacity(&a) > 1.0, "clouds in view");
+    assert!(mean_abs(&a, &b, 3) < 1e-3 && mean_abs(&a, &b, 1) < 1e-3);
+
+    let mut err = |depth: &wgpu::Texture| {
+        let dv = depth.create_view(&Default::default());
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let e = c
+            .render_clouds(&mut enc, Some(&dv), &view)
+            .map(|_| ())
+            .expect_err("refused");
+        e.to_string()
+    };
+    let msaa = depth_of(&ctx, wgpu::TextureFormat::Depth32Float, 4, bind);
+    assert!(err(&msaa).contains("4 samples"));
+    let unbindable = depth_of(
+        &ctx,
+        wgpu::TextureFormat::Depth32Float,
+        1,
+        wgpu::TextureUsages::empty(),
+    );
+    assert!(err(&unbindable).contains("lacks TEXTURE_BINDING"));
+
+    let target = textures::create_2d(
+        &ctx.device,
+        "app.target",
+        W + 1,
+        H,
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let tv = target.create_view(&Default::default());
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    let e = c
+        .render(&mut enc, &tv, None, &view)
+        .expect_err("a wider target");
+    assert!(
+        e.to_string()
+            .contains(&format!("the target is {}x{H}", W + 1)),
+        "{e}"
+    );
+}

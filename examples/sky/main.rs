@@ -259,6 +259,12 @@ impl App {
             }
             _ => return Ok(()),
         };
+        // The renderer refuses a target of another size than its own; a
+        // surface may hand one out before the resize event arrives.
+        let size = (frame.texture.width(), frame.texture.height());
+        if g.clouds.size() != size {
+            g.clouds.resize(size.0, size.1);
+        }
         let view = frame
             .texture
             .create_view(&wgpu::TextureViewDescriptor::default());

@@ -6,6 +6,7 @@ mod bind;
 mod cloud_pass;
 mod composite_pass;
 pub mod context;
+mod frame_checks;
 pub mod headless;
 mod inputs;
 pub mod light_volume_pass;

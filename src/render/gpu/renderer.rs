@@ -32,6 +32,7 @@ use super::cloud_pass::CloudPass;
 pub use super::cloud_pass::PASS_CLOUDS;
 use super::composite_pass::CompositePass;
 pub use super::composite_pass::PASS_COMPOSITE;
+use super::frame_checks;
 use super::inputs::Inputs;
 use super::light_volume_pass::LightVolumePass;
 pub use super::light_volume_pass::PASS_LIGHT_VOLUME;
@@ -67,6 +68,23 @@ pub enum RenderError {
     },
     #[error("the depth buffer's format {0:?} is not a depth format")]
     NotADepthFormat(wgpu::TextureFormat),
+    #[error(
+        "the depth buffer has {0} samples: resolve a multisampled depth buffer to one sample first"
+    )]
+    DepthMultisampled(u32),
+    #[error(
+        "the depth buffer's usage {0:?} lacks TEXTURE_BINDING, which the cloud pass reads it with"
+    )]
+    DepthNotBindable(wgpu::TextureUsages),
+    #[error(
+        "the target is {target_w}x{target_h} but the renderer is {width}x{height}: call resize() with the target's size"
+    )]
+    TargetSizeMismatch {
+        target_w: u32,
+        target_h: u32,
+        width: u32,
+        height: u32,
+    },
     #[error(
         "the target's format {target:?} is not the format {expected:?} the renderer was created for"
     )]
@@ -473,8 +491,10 @@ impl CloudRenderer {
         if self.width == 0 || self.height == 0 {
             return Ok(());
         }
-        self.check_target(target)?;
-        self.check_depth(depth)?;
+        let size = (self.width, self.height);
+        frame_checks::check_target(target, self.target_format, size)?;
+        let depth_only = frame_checks::check_depth(depth, size)?;
+        let depth = depth_only.as_ref().or(depth);
         let view = self.view_of(camera);
         self.write_uniforms(&view, self.terrain.is_some(), true);
         let constants = self.settings.constants();
@@ -556,7 +576,8 @@ impl CloudRenderer {
         if self.width == 0 || self.height == 0 {
             return Ok(None);
         }
-        self.check_depth(depth)?;
+        let depth_only = frame_checks::check_depth(depth, (self.width, self.height))?;
+        let depth = depth_only.as_ref().or(depth);
         let view = self.view_of(camera);
         self.write_uniforms(&view, false, false);
         let constants = self.settings.constants();
@@ -611,37 +632,6 @@ impl CloudRenderer {
         };
         self.frame_index = self.frame_index.wrapping_add(1);
         resolved
-    }
-
-    /// The target's format.
-    fn check_target(&self, target: &wgpu::TextureView) -> Result<(), RenderError> {
-        let tf = target.texture().format();
-        if tf != self.target_format {
-            return Err(RenderError::TargetFormat {
-                target: tf,
-                expected: self.target_format,
-            });
-        }
-        Ok(())
-    }
-
-    /// The depth buffer's format and size.
-    fn check_depth(&self, depth: Option<&wgpu::TextureView>) -> Result<(), RenderError> {
-        if let Some(d) = depth {
-            let t = d.texture();
-            if !t.format().is_depth_stencil_format() {
-                return Err(RenderError::NotADepthFormat(t.format()));
-            }
-            if (t.width(), t.height()) != (self.width, self.height) {
-                return Err(RenderError::DepthSizeMismatch {
-                    depth_w: t.width(),
-                    depth_h: t.height(),
-                    width: self.width,
-                    height: self.height,
-                });
-            }
-        }
-        Ok(())
     }
 
     /// Writes the frame's uniforms for `view` (a camera cut resets the

@@ -1,0 +1,78 @@
+//! What [`super::CloudRenderer::render`] and `render_clouds` check of an
+//! application's target and depth buffer before recording anything: a
+//! mismatch returns a [`RenderError`] naming it, where wgpu's validation
+//! would otherwise panic inside the caller's frame (a multisampled or
+//! unbindable depth buffer) or the picture would be silently wrong (a
+//! target of another size than the renderer's, whose cloud layer the
+//! composite reads pixel for pixel).
+
+use super::renderer::RenderError;
+
+/// The target: the renderer's format and size.
+pub(super) fn check_target(
+    target: &wgpu::TextureView,
+    format: wgpu::TextureFormat,
+    size: (u32, u32),
+) -> Result<(), RenderError> {
+    let t = target.texture();
+    if t.format() != format {
+        return Err(RenderError::TargetFormat {
+            target: t.format(),
+            expected: format,
+        });
+    }
+    if (t.width(), t.height()) != size {
+        return Err(RenderError::TargetSizeMismatch {
+            target_w: t.width(),
+            target_h: t.height(),
+            width: size.0,
+            height: size.1,
+        });
+    }
+    Ok(())
+}
+
+/// The depth buffer: a depth format, the renderer's size, one sample,
+/// `TEXTURE_BINDING` usage. For a depth-stencil format the passes bind a
+/// view of its depth alone, returned here (a shader's `texture_depth_2d`
+/// cannot bind both aspects, and a default view of such a texture has
+/// both).
+pub(super) fn check_depth(
+    depth: Option<&wgpu::TextureView>,
+    size: (u32, u32),
+) -> Result<Option<wgpu::TextureView>, RenderError> {
+    let Some(d) = depth else { return Ok(None) };
+    let t = d.texture();
+    let format = t.format();
+    if !format.is_depth_stencil_format() {
+        return Err(RenderError::NotADepthFormat(format));
+    }
+    if (t.width(), t.height()) != size {
+        return Err(RenderError::DepthSizeMismatch {
+            depth_w: t.width(),
+            depth_h: t.height(),
+            width: size.0,
+            height: size.1,
+        });
+    }
+    if t.sample_count() != 1 {
+        return Err(RenderError::DepthMultisampled(t.sample_count()));
+    }
+    if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
+        return Err(RenderError::DepthNotBindable(t.usage()));
+    }
+    Ok(format.has_stencil_aspect().then(|| {
+        t.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("cumulus.depth_only"),
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..Default::default()
+        })
+    }))
+}
+
+/// The renderer can move to or be shared with another thread (its wgpu
+/// handles are); checked when the crate compiles.
+const _: () = {
+    const fn send_and_sync<T: Send + Sync>() {}
+    send_and_sync::<super::CloudRenderer>();
+};
