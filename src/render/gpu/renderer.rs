@@ -131,9 +131,16 @@ pub enum RenderError {
 /// );
 /// clouds.resize(1280, 720);
 /// let mut sim = Simulation::new(scene.physics.clone(), atm);
+/// // Parcels rise where the cloud map has its clouds.
+/// sim.set_spawn_sites(cumulus::prepare::spawn_sites(&cloud_map, scene.physics.domain_size_m));
 /// let mut p = ProjectedField::new(128, 128);
-/// // Each frame: step the physics, re-project P, upload it, record.
-/// sim.step();
+/// // Each frame: advance the physics by the frame's own time (a physics
+/// // step is `dt_s`, 5 s by default: stepping once a frame would run the
+/// // sky 300 times too fast at 60 frames a second), and re-project and
+/// // upload P when the sky has moved, e.g. once per physics step (each
+/// // upload blurs P on the CPU and rebuilds the light volume).
+/// let frame_s = 1.0 / 60.0;
+/// sim.advance(frame_s);
 /// sim.project_into(&mut p, band);
 /// clouds.update_field(queue, &p);
 /// let mut encoder = device.create_command_encoder(&Default::default());
