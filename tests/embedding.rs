@@ -507,3 +507,64 @@ fn engine_depth_buffers_are_bound_or_refused_by_name() {
         "{e}"
     );
 }
+
+/// Over an engine's depth buffer the composite blends the clouds into
+/// its colour, which a device blends into an `Rgba32Float` target only
+/// with `FLOAT32_BLENDABLE`: without it, a `RenderError` that says so
+/// (wgpu's validation panicked), and `Rgba16Float`, always blendable,
+/// draws.
+#[test]
+fn an_unblendable_hdr_target_over_depth_is_refused_by_name() {
+    let Some(ctx) = gpu() else { return };
+    let (sc, p) = prepared();
+    let r = &sc.render;
+    let view = engine_view(&sc);
+    let depth = depth_of(
+        &ctx,
+        wgpu::TextureFormat::Depth32Float,
+        1,
+        wgpu::TextureUsages::TEXTURE_BINDING,
+    );
+    let dv = depth.create_view(&Default::default());
+    for format in [
+        wgpu::TextureFormat::Rgba32Float,
+        wgpu::TextureFormat::Rgba16Float,
+    ] {
+        let mut c = CloudRenderer::new(
+            &ctx.device,
+            &ctx.queue,
+            format,
+            &p.gpu_settings(r, r.quality()),
+            &p.cloud_map,
+            None,
+        );
+        c.update_field(&ctx.queue, &p.field);
+        c.resize(W, H);
+        let target = textures::create_2d(
+            &ctx.device,
+            "app.hdr",
+            W,
+            H,
+            format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let tv = target.create_view(&Default::default());
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let drawn = c.render(&mut enc, &tv, Some(&dv), &view);
+        let blendable = format == wgpu::TextureFormat::Rgba16Float
+            || ctx
+                .device
+                .features()
+                .contains(wgpu::Features::FLOAT32_BLENDABLE);
+        match drawn {
+            Ok(()) => {
+                assert!(blendable, "{format:?} drawn without blending support");
+                ctx.queue.submit([enc.finish()]);
+            }
+            Err(e) => {
+                assert!(!blendable, "{format:?}: {e}");
+                assert!(e.to_string().contains("cannot be blended into"), "{e}");
+            }
+        }
+    }
+}

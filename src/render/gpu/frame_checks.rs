@@ -8,11 +8,17 @@
 
 use super::renderer::RenderError;
 
-/// The target: the renderer's format and size.
+/// The target: the renderer's format and size, and, where the composite
+/// blends the clouds over the application's colour (`blended`: its depth
+/// buffer given, no terrain of the scene's own), a format the device
+/// blends into (`Rgba32Float` only with `FLOAT32_BLENDABLE` in
+/// `features`).
 pub(super) fn check_target(
     target: &wgpu::TextureView,
     format: wgpu::TextureFormat,
     size: (u32, u32),
+    blended: bool,
+    features: wgpu::Features,
 ) -> Result<(), RenderError> {
     let t = target.texture();
     if t.format() != format {
@@ -20,6 +26,9 @@ pub(super) fn check_target(
             target: t.format(),
             expected: format,
         });
+    }
+    if blended && !blendable(t.format(), features) {
+        return Err(RenderError::TargetNotBlendable(t.format()));
     }
     if (t.width(), t.height()) != size {
         return Err(RenderError::TargetSizeMismatch {
@@ -30,6 +39,14 @@ pub(super) fn check_target(
         });
     }
     Ok(())
+}
+
+/// Whether a device with `features` blends into `format`.
+fn blendable(format: wgpu::TextureFormat, features: wgpu::Features) -> bool {
+    format
+        .guaranteed_format_features(features)
+        .flags
+        .contains(wgpu::TextureFormatFeatureFlags::BLENDABLE)
 }
 
 /// The depth buffer: a depth format, the renderer's size, one sample,

@@ -77,6 +77,10 @@ pub enum RenderError {
     )]
     DepthNotBindable(wgpu::TextureUsages),
     #[error(
+        "the target's format {0:?} cannot be blended into on this device, and the clouds are blended over the application's colour where a depth buffer is given: use Rgba16Float, or request wgpu's FLOAT32_BLENDABLE feature"
+    )]
+    TargetNotBlendable(wgpu::TextureFormat),
+    #[error(
         "the target is {target_w}x{target_h} but the renderer is {width}x{height}: call resize() with the target's size"
     )]
     TargetSizeMismatch {
@@ -499,7 +503,14 @@ impl CloudRenderer {
             return Ok(());
         }
         let size = (self.width, self.height);
-        frame_checks::check_target(target, self.target_format, size)?;
+        let blended = depth.is_some() && self.terrain.is_none();
+        frame_checks::check_target(
+            target,
+            self.target_format,
+            size,
+            blended,
+            self.device.features(),
+        )?;
         let depth_only = frame_checks::check_depth(depth, size)?;
         let depth = depth_only.as_ref().or(depth);
         let view = self.view_of(camera);
