@@ -6,7 +6,50 @@
 //! target of another size than the renderer's, whose cloud layer the
 //! composite reads pixel for pixel).
 
-use super::renderer::RenderError;
+/// Errors of [`super::CloudRenderer::render`] and `render_clouds`: what
+/// the checks below find wrong with the target or the depth buffer.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum RenderError {
+    #[error(
+        "the depth buffer is {depth_w}x{depth_h} but the renderer is {width}x{height}: call resize() with the target's size"
+    )]
+    DepthSizeMismatch {
+        depth_w: u32,
+        depth_h: u32,
+        width: u32,
+        height: u32,
+    },
+    #[error("the depth buffer's format {0:?} is not a depth format")]
+    NotADepthFormat(wgpu::TextureFormat),
+    #[error(
+        "the depth buffer has {0} samples: resolve a multisampled depth buffer to one sample first"
+    )]
+    DepthMultisampled(u32),
+    #[error(
+        "the depth buffer's usage {0:?} lacks TEXTURE_BINDING, which the cloud pass reads it with"
+    )]
+    DepthNotBindable(wgpu::TextureUsages),
+    #[error(
+        "the target's format {0:?} cannot be blended into on this device, and the clouds are blended over the application's colour where a depth buffer is given: use Rgba16Float, or request wgpu's FLOAT32_BLENDABLE feature"
+    )]
+    TargetNotBlendable(wgpu::TextureFormat),
+    #[error(
+        "the target is {target_w}x{target_h} but the renderer is {width}x{height}: call resize() with the target's size"
+    )]
+    TargetSizeMismatch {
+        target_w: u32,
+        target_h: u32,
+        width: u32,
+        height: u32,
+    },
+    #[error(
+        "the target's format {target:?} is not the format {expected:?} the renderer was created for"
+    )]
+    TargetFormat {
+        target: wgpu::TextureFormat,
+        expected: wgpu::TextureFormat,
+    },
+}
 
 /// The target: the renderer's format and size, and, where the composite
 /// blends the clouds over the application's colour (`blended`: its depth

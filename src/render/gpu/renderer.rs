@@ -33,6 +33,7 @@ pub use super::cloud_pass::PASS_CLOUDS;
 use super::composite_pass::CompositePass;
 pub use super::composite_pass::PASS_COMPOSITE;
 use super::frame_checks;
+pub use super::frame_checks::RenderError;
 use super::inputs::Inputs;
 use super::light_volume_pass::LightVolumePass;
 pub use super::light_volume_pass::PASS_LIGHT_VOLUME;
@@ -53,50 +54,6 @@ use crate::render::cpu::light_volume::DiffusionGrid;
 use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
-
-/// Errors of [`CloudRenderer::render`].
-#[derive(Debug, thiserror::Error, PartialEq)]
-pub enum RenderError {
-    #[error(
-        "the depth buffer is {depth_w}x{depth_h} but the renderer is {width}x{height}: call resize() with the target's size"
-    )]
-    DepthSizeMismatch {
-        depth_w: u32,
-        depth_h: u32,
-        width: u32,
-        height: u32,
-    },
-    #[error("the depth buffer's format {0:?} is not a depth format")]
-    NotADepthFormat(wgpu::TextureFormat),
-    #[error(
-        "the depth buffer has {0} samples: resolve a multisampled depth buffer to one sample first"
-    )]
-    DepthMultisampled(u32),
-    #[error(
-        "the depth buffer's usage {0:?} lacks TEXTURE_BINDING, which the cloud pass reads it with"
-    )]
-    DepthNotBindable(wgpu::TextureUsages),
-    #[error(
-        "the target's format {0:?} cannot be blended into on this device, and the clouds are blended over the application's colour where a depth buffer is given: use Rgba16Float, or request wgpu's FLOAT32_BLENDABLE feature"
-    )]
-    TargetNotBlendable(wgpu::TextureFormat),
-    #[error(
-        "the target is {target_w}x{target_h} but the renderer is {width}x{height}: call resize() with the target's size"
-    )]
-    TargetSizeMismatch {
-        target_w: u32,
-        target_h: u32,
-        width: u32,
-        height: u32,
-    },
-    #[error(
-        "the target's format {target:?} is not the format {expected:?} the renderer was created for"
-    )]
-    TargetFormat {
-        target: wgpu::TextureFormat,
-        expected: wgpu::TextureFormat,
-    },
-}
 
 /// The wgpu cloud renderer. It sees the simulation only through the
 /// projected field P ([`CloudRenderer::update_field`]).
