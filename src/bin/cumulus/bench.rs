@@ -53,7 +53,6 @@ pub fn run(a: BenchArgs) -> Result<()> {
         methods_only: a.methods,
     };
     crate::create_output_folder(&a.out)?;
-    crate::guard_output_dir(&a.out);
     let report = gpu_bench::run(&ctx, &scene, &o, |line| eprintln!("{line}"))?;
     gpu_bench::write(&report, &a.out)?;
     if !report.rows.is_empty() {

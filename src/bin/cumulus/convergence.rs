@@ -37,7 +37,6 @@ pub fn run(a: ConvergenceArgs) -> Result<()> {
     }
     let atm = scene.atmosphere(None)?;
     crate::create_output_folder(&a.out)?;
-    crate::guard_output_dir(&a.out);
     let dts = convergence::DEFAULT_DTS_S;
     let bar = progress_bar(dts.len() as u64 + 1, "convergence");
     let report = convergence::measure(&scene.physics, &atm, a.duration_s, &dts, || bar.inc(1));

@@ -267,8 +267,9 @@ fn guard_output_dir(dir: &Path) {
     }
 }
 
-/// Makes the output folder `dir` (and its parents); an existing file
-/// there is refused by name (the OS said only "File exists").
+/// Makes the output folder `dir` (and its parents), an existing file
+/// there refused by name (the OS said only "File exists"), and guards it
+/// ([`guard_output_dir`]).
 fn create_output_folder(dir: &Path) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         bail!(
@@ -277,7 +278,9 @@ fn create_output_folder(dir: &Path) -> Result<()> {
         );
     }
     std::fs::create_dir_all(dir)
-        .with_context(|| format!("{}: cannot create the folder", dir.display()))
+        .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
+    guard_output_dir(dir);
+    Ok(())
 }
 
 /// [`guard_output_dir`] for the folder the output file `path` is written

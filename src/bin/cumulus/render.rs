@@ -12,8 +12,8 @@ use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
 use cumulus::scene::{Method, RenderMethod, Scene};
 
 use crate::{
-    check_output_file, gpu_context, guard_output_dir, guard_output_file, load_scene, progress_bar,
-    with_overrides, write_exr,
+    check_output_file, gpu_context, guard_output_file, load_scene, progress_bar, with_overrides,
+    write_exr,
 };
 
 #[derive(clap::Args)]
@@ -204,7 +204,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let frame = prepared.frame(r, quality);
     if let Some(dir) = &a.quality_report {
         crate::create_output_folder(dir)?;
-        guard_output_dir(dir);
         let (w, h) = (r.width.min(320), r.height.min(240));
         let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");
         let report = render_quality::measure(&frame, w, h, &render_quality::STEPS, || bar.inc(1));

@@ -62,7 +62,6 @@ pub fn run(a: StatsArgs) -> Result<()> {
         }
     })?;
     crate::create_output_folder(&a.out)?;
-    crate::guard_output_dir(&a.out);
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
