@@ -61,33 +61,13 @@ fn renderer(ctx: &GpuContext, sc: &Scene, p: &Prepared) -> CloudRenderer {
 /// A depth buffer cleared to `value` everywhere: a plane of constant
 /// camera-space depth, in whatever convention `value` was computed in.
 fn depth_buffer(ctx: &GpuContext, value: f32) -> wgpu::Texture {
-    let t = textures::create_2d(
-        &ctx.device,
-        "app.depth",
-        W,
-        H,
+    depth_of(
+        ctx,
         wgpu::TextureFormat::Depth32Float,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-    );
-    let view = t.create_view(&Default::default());
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("app.clear"),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(value),
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    ctx.queue.submit([enc.finish()]);
-    t
+        1,
+        wgpu::TextureUsages::TEXTURE_BINDING,
+        value,
+    )
 }
 
 /// The clouds-only layer for `view` up to `depth`.
@@ -403,13 +383,18 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
     );
 }
 
-/// A depth buffer of `format`, `samples` and `usage`, cleared to the far
-/// value of [`engine_view`]'s reversed Z, 0.
+/// The far value of [`engine_view`]'s reversed Z: a depth buffer cleared
+/// to it is all sky.
+const FAR: f32 = 0.0;
+
+/// A depth buffer of `format`, `samples` and `usage` (and
+/// `RENDER_ATTACHMENT`), cleared to `value` (a stencil aspect to 0).
 fn depth_of(
     ctx: &GpuContext,
     format: wgpu::TextureFormat,
     samples: u32,
     usage: wgpu::TextureUsages,
+    value: f32,
 ) -> wgpu::Texture {
     let t = ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("app.depth"),
@@ -433,7 +418,7 @@ fn depth_of(
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &view,
             depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(0.0),
+                load: wgpu::LoadOp::Clear(value),
                 store: wgpu::StoreOp::Store,
             }),
             stencil_ops: format.has_stencil_aspect().then_some(wgpu::Operations {
@@ -462,8 +447,8 @@ fn engine_depth_buffers_are_bound_or_refused_by_name() {
     let mut c = renderer(&ctx, &sc, &p);
     let view = engine_view(&sc);
     let bind = wgpu::TextureUsages::TEXTURE_BINDING;
-    let plain = depth_of(&ctx, wgpu::TextureFormat::Depth32Float, 1, bind);
-    let stencil = depth_of(&ctx, wgpu::TextureFormat::Depth24PlusStencil8, 1, bind);
+    let plain = depth_of(&ctx, wgpu::TextureFormat::Depth32Float, 1, bind, FAR);
+    let stencil = depth_of(&ctx, wgpu::TextureFormat::Depth24PlusStencil8, 1, bind, FAR);
     let a = clouds_only(&ctx, &mut c, Some(&plain), &view);
     let b = clouds_only(&ctx, &mut c, Some(&stencil), &view);
     assert!(opacity(&a) > 1.0, "clouds in view");
@@ -478,13 +463,14 @@ fn engine_depth_buffers_are_bound_or_refused_by_name() {
             .expect_err("refused");
         e.to_string()
     };
-    let msaa = depth_of(&ctx, wgpu::TextureFormat::Depth32Float, 4, bind);
+    let msaa = depth_of(&ctx, wgpu::TextureFormat::Depth32Float, 4, bind, FAR);
     assert!(err(&msaa).contains("4 samples"));
     let unbindable = depth_of(
         &ctx,
         wgpu::TextureFormat::Depth32Float,
         1,
         wgpu::TextureUsages::empty(),
+        FAR,
     );
     assert!(err(&unbindable).contains("lacks TEXTURE_BINDING"));
 
@@ -519,12 +505,7 @@ fn an_unblendable_hdr_target_over_depth_is_refused_by_name() {
     let (sc, p) = prepared();
     let r = &sc.render;
     let view = engine_view(&sc);
-    let depth = depth_of(
-        &ctx,
-        wgpu::TextureFormat::Depth32Float,
-        1,
-        wgpu::TextureUsages::TEXTURE_BINDING,
-    );
+    let depth = depth_buffer(&ctx, FAR);
     let dv = depth.create_view(&Default::default());
     for format in [
         wgpu::TextureFormat::Rgba32Float,
