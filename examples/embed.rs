@@ -19,7 +19,7 @@ use anyhow::{Context, Result};
 use cumulus::prepare::spawn_sites;
 use cumulus::render::camera::View;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
-use cumulus::render::gpu::{CloudRenderer, GpuContext};
+use cumulus::render::gpu::{CloudRenderer, FrameUse, GpuContext};
 use cumulus::scene::RenderSettings;
 use cumulus::sim::{
     Atmosphere, Band, ParametricProfile, PhysicsConfig, ProjectedField, Simulation,
@@ -100,6 +100,9 @@ fn main() -> Result<()> {
     let settings = look.gpu_settings(band, extent);
     let mut clouds = CloudRenderer::new(device, queue, FORMAT, &settings, &cloud_map, None);
     clouds.resize(WIDTH, HEIGHT);
+    // Compile the pipelines the frames below use (over the app's depth
+    // buffer) now, not in the first frame.
+    clouds.warm_up(&[FrameUse::Render { depth: true }]);
 
     // Spin the sky up for 40 minutes, then animate 16 frames of 5 s each,
     // the camera turning slowly.

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result, anyhow};
-use cumulus::render::gpu::{CloudRenderer, GpuContext, GpuSettings, is_hdr};
+use cumulus::render::gpu::{CloudRenderer, FrameUse, GpuContext, GpuSettings, is_hdr};
 use winit::window::Window;
 
 use crate::world::World;
@@ -117,6 +117,8 @@ fn cloud_renderer(
     );
     clouds.update_field(&ctx.queue, &world.field);
     clouds.resize(width, height);
+    // The window's first frame would otherwise compile them.
+    clouds.warm_up(&[FrameUse::Render { depth: false }]);
     clouds
 }
 

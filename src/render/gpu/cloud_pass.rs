@@ -55,8 +55,11 @@ impl CloudPass {
         self.pipelines.iter().flatten().count()
     }
 
+    /// The pipeline for a frame with or without `depth` and `light`,
+    /// built now if it does not exist yet (`CloudRenderer::warm_up` builds
+    /// it ahead of the first frame).
     #[allow(clippy::too_many_arguments)]
-    fn pipeline(
+    pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
         group0: &wgpu::BindGroupLayout,

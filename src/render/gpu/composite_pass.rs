@@ -50,7 +50,10 @@ impl CompositePass {
         self.pipelines.len()
     }
 
-    fn pipeline(
+    /// The index of the pipeline for `background` into a target of
+    /// `target_format`, built now if it does not exist yet
+    /// (`CloudRenderer::warm_up` builds it ahead of the first frame).
+    pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
         group0: &wgpu::BindGroupLayout,

@@ -307,6 +307,23 @@ impl LightVolumePass {
         self.builds
     }
 
+    /// Builds the build's pipelines if they do not exist yet (at the first
+    /// build, or ahead of it from `CloudRenderer::warm_up`).
+    pub fn warm(
+        &mut self,
+        device: &wgpu::Device,
+        group0_layout: &wgpu::BindGroupLayout,
+        constants: &[(&str, f64)],
+    ) {
+        pipelines(
+            &mut self.pipelines,
+            &self.build_layout,
+            device,
+            group0_layout,
+            constants,
+        );
+    }
+
     /// Builds the volume when it is stale: records and submits the
     /// extinction of every cell, the sun's optical depth layer by layer
     /// from the band's top, and [`LIGHT_SWEEPS`] red-black sweeps from
@@ -325,31 +342,13 @@ impl LightVolumePass {
         }
         self.stale = false;
         self.builds += 1;
-        let build_layout = &self.build_layout;
-        let p = self.pipelines.get_or_insert_with(|| {
-            let module = bind::module(device, PASS_LIGHT_VOLUME, shaders::light_volume_build());
-            let layout =
-                bind::pipeline_layout(device, PASS_LIGHT_VOLUME, &[group0_layout, build_layout]);
-            let pipeline = |entry: &str| {
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(PASS_LIGHT_VOLUME),
-                    layout: Some(&layout),
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants,
-                        zero_initialize_workgroup_memory: false,
-                    },
-                    cache: None,
-                })
-            };
-            Pipelines {
-                cell_extinction: pipeline("cell_extinction"),
-                sun_depth_layer: pipeline("sun_depth_layer"),
-                relax: pipeline("relax"),
-                fluence_texture: pipeline("fluence_texture"),
-            }
-        });
+        let p = pipelines(
+            &mut self.pipelines,
+            &self.build_layout,
+            device,
+            group0_layout,
+            constants,
+        );
         let g = &self.grid;
         let all = workgroups(g.len() as u32);
         let columns = workgroups(g.cells.x * g.cells.z);
@@ -386,6 +385,40 @@ impl LightVolumePass {
         }
         queue.submit([encoder.finish()]);
     }
+}
+
+/// The build's pipelines in `slot`, made there first if it is empty.
+fn pipelines<'a>(
+    slot: &'a mut Option<Pipelines>,
+    build_layout: &wgpu::BindGroupLayout,
+    device: &wgpu::Device,
+    group0_layout: &wgpu::BindGroupLayout,
+    constants: &[(&str, f64)],
+) -> &'a Pipelines {
+    slot.get_or_insert_with(|| {
+        let module = bind::module(device, PASS_LIGHT_VOLUME, shaders::light_volume_build());
+        let layout =
+            bind::pipeline_layout(device, PASS_LIGHT_VOLUME, &[group0_layout, build_layout]);
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(PASS_LIGHT_VOLUME),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    zero_initialize_workgroup_memory: false,
+                },
+                cache: None,
+            })
+        };
+        Pipelines {
+            cell_extinction: pipeline("cell_extinction"),
+            sun_depth_layer: pipeline("sun_depth_layer"),
+            relax: pipeline("relax"),
+            fluence_texture: pipeline("fluence_texture"),
+        }
+    })
 }
 
 #[cfg(test)]

@@ -26,6 +26,6 @@ pub mod volume_pass;
 pub use composite_pass::is_hdr;
 pub use context::{GpuContext, GpuError};
 pub use headless::Headless;
-pub use renderer::{CloudRenderer, RenderError};
+pub use renderer::{CloudRenderer, FrameUse, RenderError};
 pub use settings::GpuSettings;
 pub use tsaa::TsaaSettings;

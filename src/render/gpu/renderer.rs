@@ -55,6 +55,17 @@ use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
 
+/// How an application draws with a [`CloudRenderer`], for
+/// [`CloudRenderer::warm_up`]: each way needs its own pipelines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameUse {
+    /// [`CloudRenderer::render`], with or without the application's depth
+    /// buffer.
+    Render { depth: bool },
+    /// [`CloudRenderer::render_clouds`], with or without it.
+    CloudsOnly { depth: bool },
+}
+
 /// The wgpu cloud renderer. It sees the simulation only through the
 /// projected field P ([`CloudRenderer::update_field`]).
 ///
@@ -72,7 +83,7 @@ use crate::sim::ProjectedField;
 /// # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, view: &wgpu::TextureView)
 /// #     -> Result<(), Box<dyn std::error::Error>> {
 /// use cumulus::render::cloud_map::CloudMap;
-/// use cumulus::render::gpu::CloudRenderer;
+/// use cumulus::render::gpu::{CloudRenderer, FrameUse};
 /// use cumulus::scene::Scene;
 /// use cumulus::sim::{ProjectedField, Simulation};
 ///
@@ -91,6 +102,8 @@ use crate::sim::ProjectedField;
 ///     None,
 /// );
 /// clouds.resize(1280, 720);
+/// // Compile the pipelines now, not in the first frame.
+/// clouds.warm_up(&[FrameUse::Render { depth: false }]);
 /// let mut sim = Simulation::new(scene.physics.clone(), atm);
 /// // Parcels rise where the cloud map has its clouds.
 /// sim.set_spawn_sites(cumulus::prepare::spawn_sites(&cloud_map, scene.physics.domain_size_m));
@@ -283,6 +296,56 @@ impl CloudRenderer {
                 l.invalidate();
             } else if old.density != s.density || old.sun_dir() != s.sun_dir() {
                 l.mark_stale();
+            }
+        }
+    }
+
+    /// Builds now the pipelines that frames drawn as `uses` need (the
+    /// light volume's build, the cloud pass's and the composite's; the
+    /// terrain's and TSAA's are built with their passes), so the first
+    /// frame does not stall while the driver compiles them: call it
+    /// behind a loading screen. Without it they are built on first use.
+    /// A change of settings that changes their constants or the sky model
+    /// drops them again: call it again after such a
+    /// [`Self::set_settings`]. [`Self::pipelines`] lists what exists.
+    pub fn warm_up(&mut self, uses: &[FrameUse]) {
+        let constants = self.settings.constants();
+        let physical = self.inputs.sky.is_some();
+        if let Some(l) = &mut self.light {
+            l.warm(&self.device, &self.inputs.layout, &constants);
+        }
+        let light = self.light.as_ref().map(|l| &l.read_layout);
+        for u in uses {
+            // As `render` and `render_clouds` choose them.
+            let (depth, background) = match *u {
+                FrameUse::Render { depth } => {
+                    let background = match (self.terrain.is_some(), depth) {
+                        (true, _) => Background::Terrain,
+                        (false, true) => Background::ExternalDepth,
+                        (false, false) => Background::Sky,
+                    };
+                    (depth || self.terrain.is_some(), Some(background))
+                }
+                FrameUse::CloudsOnly { depth } => (depth, None),
+            };
+            self.clouds.pipeline(
+                &self.device,
+                &self.inputs.layout,
+                &constants,
+                depth,
+                self.tsaa.is_some(),
+                physical,
+                light,
+            );
+            if let Some(b) = background {
+                self.composite.pipeline(
+                    &self.device,
+                    &self.inputs.layout,
+                    &constants,
+                    self.target_format,
+                    b,
+                    physical,
+                );
             }
         }
     }
