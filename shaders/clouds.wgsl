@@ -138,7 +138,7 @@ struct Frame {
     band: vec4f,         // bottom (m), top (m), coverage, extinction (1/m)
     map: vec4f,          // extent (m), detail strength, detail scale (m), map texel (m)
     jitter: vec4f,       // sub-pixel offset x, y (px), dither offset, TSAA blend
-    terrain: vec4f,      // extent (m), highest point (m), the sea's clock (s), unused
+    terrain: vec4f,      // extent (m), highest point (m), the sea's clock (s), mesh stride
     counts: vec4u,       // steps, P width, P height, frame index
     mask: vec4u,         // mask width, height, P texels per mask cell, unused
     view_proj: mat4x4f,

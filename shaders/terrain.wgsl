@@ -72,10 +72,20 @@ struct TerrainVertex {
     @location(0) world: vec3f,
 }
 
+// The most tiles the mesh reaches out in each direction (the scene
+// refuses tiles so small that rays would reach further).
+const TERRAIN_REACH_MAX: u32 = 512u;
+
+// One vertex of tile `ii`'s mesh: every `frame.terrain.w`-th height of
+// the heightfield (1 unless the full mesh of every tile out to the
+// longest ray would exceed the pass's vertex budget, `mesh_stride`), the
+// last quad of a row narrower when the stride does not divide the side.
 @vertex
 fn vs_terrain(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> TerrainVertex {
     let n = textureDimensions(height_tex).x;
     let extent = frame.terrain.x;
+    let stride = max(u32(frame.terrain.w), 1u);
+    let m = (n + stride - 1u) / stride;
     let quad = vi / 6u;
     let corner = vi % 6u;
     var d = vec2u(0u, 0u);
@@ -86,9 +96,9 @@ fn vs_terrain(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
     } else if corner == 5u {
         d = vec2u(1u, 1u);
     }
-    let g = vec2u(quad % n, quad / n) + d;
+    let g = min((vec2u(quad % m, quad / m) + d) * stride, vec2u(n));
     // Tiles around the camera's tile, enough to reach the longest ray.
-    let reach = i32(ceil(frame.sun_light.w / extent));
+    let reach = i32(min(u32(ceil(frame.sun_light.w / extent)), TERRAIN_REACH_MAX));
     let side = 2 * reach + 1;
     let tile = vec2i(i32(ii) % side - reach, i32(ii) / side - reach)
         + vec2i(floor(frame.cam_pos.xz / extent));

@@ -70,6 +70,10 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("FBM_OCTAVES", spheroids::FBM_OCTAVES as f64),
         ("FBM_CONTRAST", spheroids::FBM_CONTRAST as f64),
         (
+            "TERRAIN_REACH_MAX",
+            cumulus::render::gpu::terrain_pass::TERRAIN_REACH_MAX as f64,
+        ),
+        (
             "VOLUME_SHADOW_STEPS",
             cumulus::render::cpu::volume::VOLUME_SHADOW_STEPS as f64,
         ),

@@ -143,8 +143,24 @@ impl Scene {
         })?;
         scene.source = Some(path.to_owned());
         scene.text = Some(text.to_owned());
+        scene.sky_as_drawn();
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// The pseudo-spheroids and the endless volumes draw the analytic sky
+    /// (their passes bind no sky tables), so their scenes' sky model is
+    /// the analytic one whatever `[render.atmosphere] model` says: the
+    /// auto-exposure meters the sky that is drawn. Metered from the
+    /// physical sky, which darkens below the horizon while the analytic
+    /// one does not, a sun 10° down opened the exposure 12.7 stops and
+    /// burnt 83 % of the picture to white.
+    pub fn sky_as_drawn(&mut self) {
+        if self.render.renderer == RenderMethod::Spheroids
+            || self.simulation.method == Method::Endless
+        {
+            self.render.atmosphere.model = crate::render::cpu::sky::SkyModel::Analytic;
+        }
     }
 
     /// Checks every value against its domain, each section with its own
@@ -398,6 +414,56 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spheroids_and_the_endless_volumes_meter_the_analytic_sky_they_draw() {
+        use crate::render::cpu::exposure::auto_exposure_factor;
+        use crate::render::cpu::sky::SkyModel;
+        let physical = |renderer: &str, method: &str| {
+            let text = format!(
+                "[simulation]\nmethod = \"{method}\"\n\n[render]\nrenderer = \"{renderer}\"\n\
+                 sun_elevation_deg = -10.0\n\n[render.atmosphere]\nmodel = \"physical\"\n"
+            );
+            Scene::parse(&text, Path::new("s.toml")).expect("valid")
+        };
+        for s in [
+            physical("spheroids", "parcels"),
+            physical("cloud_map", "endless"),
+        ] {
+            let r = &s.render;
+            assert_eq!(r.atmosphere.model, SkyModel::Analytic);
+            let analytic = auto_exposure_factor(&r.atmosphere, -10.0, r.camera_position_m[1]);
+            assert_eq!(r.exposure_factor(), analytic);
+        }
+        // The cloud map keeps the physical sky, and at -10° it is metered
+        // open by far more than the analytic sky (the burn-out).
+        let s = physical("cloud_map", "parcels");
+        let r = &s.render;
+        assert_eq!(r.atmosphere.model, SkyModel::Physical);
+        let mut analytic = r.atmosphere;
+        analytic.model = SkyModel::Analytic;
+        let open =
+            r.exposure_factor() / auto_exposure_factor(&analytic, -10.0, r.camera_position_m[1]);
+        assert!(open > 100.0, "physical over analytic {open}");
+    }
+
+    #[test]
+    fn terrain_tiles_too_small_for_the_longest_ray_are_refused() {
+        let text =
+            |enabled: bool| format!("[render.terrain]\nenabled = {enabled}\nextent_m = 30.0\n");
+        // 40 km rays over 30 m tiles: 1334 repeats each way, over 512.
+        let e = Scene::parse(&text(true), Path::new("s.toml")).expect_err("too small");
+        assert_eq!(
+            e.to_string(),
+            "s.toml:3: `render.terrain.extent_m`: is 30, expected at least \
+             render.max_distance_m / 512 = 78.125 m with the terrain on (it repeats every \
+             extent_m, and the GPU draws a copy per repeat out to max_distance_m)"
+        );
+        // Off, the key is not used.
+        Scene::parse(&text(false), Path::new("s.toml")).expect("terrain off");
+        let ok = "[render]\nmax_distance_m = 15000.0\n\n[render.terrain]\nenabled = true\nextent_m = 30.0\n";
+        Scene::parse(ok, Path::new("s.toml")).expect("15 km rays: 500 repeats");
+    }
 
     #[test]
     fn negative_radius_names_key_and_line() {

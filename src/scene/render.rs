@@ -10,6 +10,7 @@ use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::exposure::auto_exposure_factor;
 use crate::render::cpu::renderer::Quality;
 use crate::render::cpu::sky::{AtmosphereConfig, GroundConfig};
+use crate::render::gpu::terrain_pass::TERRAIN_REACH_MAX;
 use crate::render::gpu::{GpuSettings, TsaaSettings};
 use crate::render::terrain::TerrainConfig;
 use crate::sim::{Band, Check};
@@ -337,6 +338,18 @@ impl RenderSettings {
                 1.0,
                 1e7,
                 "1..=1e7 m",
+            ),
+            Check::new(
+                "render.terrain.extent_m",
+                !r.terrain.enabled
+                    || r.max_distance_m / r.terrain.extent_m <= TERRAIN_REACH_MAX as f32,
+                format!(
+                    "at least render.max_distance_m / {TERRAIN_REACH_MAX} = {} m with the \
+                     terrain on (it repeats every extent_m, and the GPU draws a copy per \
+                     repeat out to max_distance_m)",
+                    r.max_distance_m / TERRAIN_REACH_MAX as f32
+                ),
+                f(r.terrain.extent_m),
             ),
             range("render.terrain.hills", r.terrain.hills, 1.0, 64.0, "1..=64"),
             range(

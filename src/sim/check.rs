@@ -32,7 +32,10 @@ impl Check {
         }
     }
 
-    /// A check that `value` is finite and in `lo..=hi`.
+    /// A check that `value` is finite and in `lo..=hi`. A value read
+    /// into an `f32` field (and widened) is held against the bounds as
+    /// `f32`s: `1e-6` written for a bound of `1e-6` reads as the f32
+    /// nearest it, 9.99999997e-7, which the f64 bound refused.
     pub fn range(
         key: impl Into<Cow<'static, str>>,
         value: f64,
@@ -40,6 +43,11 @@ impl Check {
         hi: f64,
         expected: &'static str,
     ) -> Self {
+        let (lo, hi) = if f64::from(value as f32) == value {
+            (f64::from(lo as f32), f64::from(hi as f32))
+        } else {
+            (lo, hi)
+        };
         Self::new(key, finite_in(value, lo, hi), expected, value)
     }
 }
@@ -64,6 +72,21 @@ pub fn finite_in(v: f64, lo: f64, hi: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_f32_value_written_as_its_bound_is_within_it() {
+        // `render.extinction_per_m = 1e-6` was refused as "is 0.000001,
+        // expected 1e-6..=10".
+        for (v, lo, hi) in [(1e-6_f32, 1e-6, 10.0), (0.1, 0.1, 1.0), (0.3, 0.0, 0.3)] {
+            let c = Check::range("k", f64::from(v), lo, hi, "");
+            assert!(c.ok, "{v} in {lo}..={hi}");
+        }
+        // Just outside stays outside.
+        assert!(!Check::range("k", f64::from(0.99e-6_f32), 1e-6, 10.0, "").ok);
+        assert!(!Check::range("k", f64::from(0.30001_f32), 0.0, 0.3, "").ok);
+        // An f64 value keeps the f64 bounds.
+        assert!(!Check::range("k", 0.999_999_999_9e-6, 1e-6, 10.0, "").ok);
+    }
 
     #[test]
     fn values_read_as_f32_are_reported_as_written() {

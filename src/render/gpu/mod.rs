@@ -16,7 +16,7 @@ pub mod shaders;
 pub mod sky_luts_pass;
 pub mod spheroids;
 mod standalone;
-mod terrain_pass;
+pub mod terrain_pass;
 pub mod textures;
 pub mod timer;
 pub mod tsaa;

@@ -695,10 +695,10 @@ impl CloudRenderer {
             None => ([0.0; 3], 1.0),
         };
         let view_proj = view.view_projection();
-        let terrain = self
-            .terrain
-            .as_ref()
-            .map_or([0.0; 2], |t| [t.extent_m, t.max_m]);
+        let terrain = self.terrain.as_ref().map_or([0.0; 3], |t| {
+            let stride = t.stride(self.settings.quality.max_distance_m);
+            [t.extent_m, t.max_m, stride as f32]
+        });
         let u = FrameUniforms::new(&FrameInputs {
             view: *view,
             depth_flipped: own_depth && view.reversed_depth(),

@@ -152,7 +152,7 @@ impl StandalonePass {
             jitter: [0.0; 3],
             blend: 1.0,
             frame_index: 0,
-            terrain: [0.0; 2],
+            terrain: [0.0; 3],
             p_size: [1, 1],
             mask: [1, 1, 1, 0],
             map_size: 1,

@@ -56,8 +56,9 @@ pub struct FrameInputs {
     /// Weight of the new frame in the TSAA history (1: history reset).
     pub blend: f32,
     pub frame_index: u32,
-    /// Terrain texture extent and highest point, m (zero without terrain).
-    pub terrain: [f32; 2],
+    /// Terrain texture extent and highest point, m, and the terrain
+    /// mesh's stride (`terrain_pass::mesh_stride`) (zero without terrain).
+    pub terrain: [f32; 3],
     /// P's width and height, texels.
     pub p_size: [u32; 2],
     /// Coverage mask: width, height, P texels per mask cell, 0.
@@ -112,7 +113,7 @@ impl FrameUniforms {
                 d.map_extent_m / i.map_size.max(1) as f32,
             ],
             jitter: [i.jitter[0], i.jitter[1], i.jitter[2], i.blend],
-            terrain: [i.terrain[0], i.terrain[1], q.sea_time_s, 0.0],
+            terrain: [i.terrain[0], i.terrain[1], q.sea_time_s, i.terrain[2]],
             counts: [q.steps.max(1), i.p_size[0], i.p_size[1], i.frame_index],
             mask: i.mask,
             view_proj: i.view.view_projection().to_cols_array_2d(),
