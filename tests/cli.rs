@@ -1198,3 +1198,37 @@ fn render_exposes_a_twilight_sky() {
         "a dusk blue: {metered:?}"
     );
 }
+
+/// lavapipe ends a shader's loops after 65,535 iterations, which the
+/// cloud pass's march passes at 1024 steps or more: `render` says so
+/// there, and not on hardware or at fewer steps.
+#[test]
+fn lavapipe_at_a_thousand_steps_is_warned_about() {
+    let Some(ctx) = common::gpu() else { return };
+    let dir = tempfile::tempdir().expect("dir");
+    let out = dir.path().join("s.png");
+    let scene = root().join("scenes/fair_weather.toml");
+    let run = |steps: &str| {
+        let o = cumulus(&[
+            "render",
+            "--scene",
+            scene.to_str().expect("utf-8"),
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--backend",
+            "gpu",
+            "--width",
+            "8",
+            "--height",
+            "6",
+            "--frames",
+            "1",
+            "--steps",
+            steps,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o).contains("on lavapipe, which ends a shader's loops after 65535 iterations")
+    };
+    assert_eq!(run("1024"), ctx.is_llvmpipe());
+    assert!(!run("512"));
+}

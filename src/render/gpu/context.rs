@@ -20,6 +20,15 @@ pub enum GpuError {
     Render(#[from] super::RenderError),
 }
 
+/// The iterations after which Mesa's llvmpipe (lavapipe) ends a shader's
+/// loops, all of them together (its `LP_MAX_TGSI_LOOP_ITERATIONS`): the
+/// cloud pass's one flat loop of a long ray through cloud at 1024
+/// primary steps or more passes it, and lavapipe's picture then departs
+/// from the CPU twin's (fair weather at 64x48: 0.1 levels from 48 to 512
+/// steps, 1.3 at 1024, 11 at distant cloud bases). Hardware has no such
+/// limit.
+pub const LLVMPIPE_LOOP_ITERATIONS: u32 = 65_535;
+
 /// A device and queue with what the renderer can use.
 pub struct GpuContext {
     pub device: wgpu::Device,
@@ -73,6 +82,13 @@ impl GpuContext {
             adapter_info,
             timestamps,
         })
+    }
+
+    /// Whether the adapter is Mesa's software rasterizer (lavapipe,
+    /// "llvmpipe"), which ends every shader loop after
+    /// [`LLVMPIPE_LOOP_ITERATIONS`].
+    pub fn is_llvmpipe(&self) -> bool {
+        self.adapter_info.name.contains("llvmpipe")
     }
 
     /// "name (backend, driver)".
