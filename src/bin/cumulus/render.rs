@@ -294,10 +294,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
 /// `render` on the GPU: `--frames` frames (TSAA converges), the last one
 /// saved; `--time-frames` times more.
 ///
-/// Primary steps from which lavapipe's loop limit
-/// ([`cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS`]) cuts
-/// rays short: measured on fair weather, 512 steps stay within 0.1 levels
-/// of the CPU and 1024 do not.
+/// Primary steps from which lavapipe departs from the CPU twin, likely
+/// by its loop limit
+/// ([`cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS`]):
+/// measured on fair weather, 512 steps stay within 0.1 levels of the CPU
+/// and 1024 do not.
 const LAVAPIPE_STEPS_MAX: u32 = 1024;
 
 fn render_gpu(
@@ -312,8 +313,8 @@ fn render_gpu(
     if ctx.is_llvmpipe() && r.steps >= LAVAPIPE_STEPS_MAX {
         eprintln!(
             "warning: {}: render.steps = {} on lavapipe, which ends a shader's loops after {} \
-             iterations: long rays through cloud are cut short and the picture is brighter \
-             than the CPU's (--backend cpu); use fewer than {LAVAPIPE_STEPS_MAX} steps",
+             iterations: from {LAVAPIPE_STEPS_MAX} steps its distant cloud bases come out \
+             brighter than the CPU's (--backend cpu); use fewer steps",
             a.scene.display(),
             r.steps,
             cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS
