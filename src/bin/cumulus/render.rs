@@ -294,12 +294,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
 /// `render` on the GPU: `--frames` frames (TSAA converges), the last one
 /// saved; `--time-frames` times more.
 ///
-/// Primary steps from which lavapipe departs from the CPU twin, likely
-/// by its loop limit
-/// ([`cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS`]):
-/// measured on fair weather, 512 steps stay within 0.1 levels of the CPU
-/// and 1024 do not.
-const LAVAPIPE_STEPS_MAX: u32 = 1024;
+/// The most primary steps times shadow steps with which lavapipe stays
+/// with the CPU twin (likely its loop limit,
+/// [`cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS`]):
+/// measured on fair weather at 64x48, 512 x 20 and 1024 x 10 are 0.10
+/// levels from the CPU, 768 x 20 0.28, 1024 x 20 1.3, 512 x 64 2.1
+/// (README, "Lavapipe at 1024 steps or more"). The default is 48 x 20.
+const LAVAPIPE_MARCH_LOAD_MAX: u32 = 10_240;
 
 fn render_gpu(
     ctx: &GpuContext,
@@ -310,13 +311,16 @@ fn render_gpu(
 ) -> Result<()> {
     let r = &scene.render;
     eprintln!("backend: gpu ({})", ctx.describe());
-    if ctx.is_llvmpipe() && r.steps >= LAVAPIPE_STEPS_MAX {
+    let load = r.steps * r.shadow_steps.max(1);
+    if ctx.is_llvmpipe() && load > LAVAPIPE_MARCH_LOAD_MAX {
         eprintln!(
-            "warning: {}: render.steps = {} on lavapipe, which ends a shader's loops after {} \
-             iterations: from {LAVAPIPE_STEPS_MAX} steps its distant cloud bases come out \
-             brighter than the CPU's (--backend cpu); use fewer steps",
+            "warning: {}: render.steps x render.shadow_steps = {} x {} = {load} on lavapipe, \
+             which ends a shader's loops after {} iterations: above {LAVAPIPE_MARCH_LOAD_MAX} \
+             its distant cloud bases come out brighter than the CPU's (--backend cpu); use \
+             fewer steps",
             a.scene.display(),
             r.steps,
+            r.shadow_steps,
             cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS
         );
     }
