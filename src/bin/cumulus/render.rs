@@ -316,8 +316,8 @@ fn render_gpu(
         eprintln!(
             "warning: {}: render.steps x render.shadow_steps = {} x {} = {load} on lavapipe, \
              which ends a shader's loops after {} iterations: above {LAVAPIPE_MARCH_LOAD_MAX} \
-             its distant cloud bases come out brighter than the CPU's (--backend cpu); use \
-             fewer steps",
+             its distant cloud bases come out brighter than the CPU's (--backend cpu); use
+             fewer steps or shadow steps",
             a.scene.display(),
             r.steps,
             r.shadow_steps,
