@@ -316,7 +316,7 @@ fn render_gpu(
         eprintln!(
             "warning: {}: render.steps x render.shadow_steps = {} x {} = {load} on lavapipe, \
              which ends a shader's loops after {} iterations: above {LAVAPIPE_MARCH_LOAD_MAX} \
-             its distant cloud bases come out brighter than the CPU's (--backend cpu); use
+             its distant cloud bases come out brighter than the CPU's (--backend cpu); use \
              fewer steps or shadow steps",
             a.scene.display(),
             r.steps,
