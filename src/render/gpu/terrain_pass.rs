@@ -15,7 +15,8 @@ pub const PASS_TERRAIN: &str = "terrain";
 /// mesh (`size²` cells) is drawn once per tile out to the longest ray,
 /// `(2R + 1)²` tiles for `R = ⌈max_distance / extent⌉`: the default
 /// terrain (256², 20 km, 40 km) is 9.8 M vertices, but 1 km tiles made
-/// 390 M and 1 m tiles 10¹⁴, and lavapipe's frame never ended. Beyond
+/// 2.6 G (6561 tiles) and 1 m tiles 2.5·10¹⁵ (6.4·10⁹ tiles, past a
+/// `u32`), and lavapipe's frame never ended. Beyond
 /// this budget (16.8 M, 1.7 times the default's) each tile's mesh takes
 /// every `s`-th height ([`mesh_stride`]).
 pub const TERRAIN_VERTEX_BUDGET: u64 = 16 << 20;
