@@ -45,7 +45,7 @@ fn texture(ctx: &GpuContext, format: wgpu::TextureFormat) -> wgpu::TextureView {
         .create_view(&Default::default())
 }
 
-/// Draws one frame of each way in `uses` and returns the pipelines after.
+/// Draws one frame of each way in `uses`.
 fn draw(ctx: &GpuContext, sc: &Scene, c: &mut CloudRenderer, uses: &[FrameUse]) {
     let target = texture(ctx, FORMAT);
     let depth = texture(ctx, wgpu::TextureFormat::Depth32Float);

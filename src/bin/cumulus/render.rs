@@ -291,9 +291,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// `render` on the GPU: `--frames` frames (TSAA converges), the last one
-/// saved; `--time-frames` times more.
-///
 /// The most primary steps times shadow steps with which lavapipe stays
 /// with the CPU twin (likely its loop limit,
 /// [`cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS`]):
@@ -302,6 +299,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
 /// (README, "Lavapipe at 1024 steps or more"). The default is 48 x 20.
 const LAVAPIPE_MARCH_LOAD_MAX: u32 = 10_240;
 
+/// `render` on the GPU: `--frames` frames (TSAA converges), the last one
+/// saved; `--time-frames` times more.
 fn render_gpu(
     ctx: &GpuContext,
     a: &RenderArgs,

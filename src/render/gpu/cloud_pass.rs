@@ -5,6 +5,7 @@
 //! (multiple scattering on) it reads its fluence as bind group 2.
 
 use super::bind::{self, Recorder};
+use super::inputs::Inputs;
 use super::shaders;
 use super::textures::{self, CLOUD_FORMAT, DISTANCE_FORMAT};
 
@@ -58,17 +59,16 @@ impl CloudPass {
     /// The pipeline for a frame with or without `depth` and `light`,
     /// built now if it does not exist yet (`CloudRenderer::warm_up` builds
     /// it ahead of the first frame).
-    #[allow(clippy::too_many_arguments)]
     pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
-        group0: &wgpu::BindGroupLayout,
+        inputs: &Inputs,
         constants: &[(&str, f64)],
         depth: bool,
         tsaa: bool,
-        physical: bool,
         light: Option<&wgpu::BindGroupLayout>,
     ) -> &wgpu::RenderPipeline {
+        let (group0, physical) = (&inputs.layout, inputs.sky.is_some());
         let (depth_layout, no_depth_layout) = (&self.depth_layout, &self.no_depth_layout);
         let slot = depth as usize + 2 * light.is_some() as usize;
         self.pipelines[slot].get_or_insert_with(|| {
@@ -96,7 +96,7 @@ impl CloudPass {
         &mut self,
         rec: &mut Recorder,
         device: &wgpu::Device,
-        inputs: &super::inputs::Inputs,
+        inputs: &Inputs,
         constants: &[(&str, f64)],
         depth: Option<&wgpu::TextureView>,
         distance: Option<&wgpu::TextureView>,
@@ -114,11 +114,10 @@ impl CloudPass {
         let pipeline = self
             .pipeline(
                 device,
-                &inputs.layout,
+                inputs,
                 constants,
                 depth.is_some(),
                 distance.is_some(),
-                inputs.sky.is_some(),
                 light.map(|l| l.0),
             )
             .clone();

@@ -56,12 +56,12 @@ impl CompositePass {
     pub fn pipeline(
         &mut self,
         device: &wgpu::Device,
-        group0: &wgpu::BindGroupLayout,
+        inputs: &Inputs,
         constants: &[(&str, f64)],
         target_format: wgpu::TextureFormat,
         background: Background,
-        physical: bool,
     ) -> usize {
+        let (group0, physical) = (&inputs.layout, inputs.sky.is_some());
         if let Some(i) = self.pipelines.iter().position(|(b, _, _)| *b == background) {
             return i;
         }
@@ -120,11 +120,10 @@ impl CompositePass {
     ) {
         let i = self.pipeline(
             device,
-            &inputs.layout,
+            inputs,
             constants,
             target.texture().format(),
             background,
-            inputs.sky.is_some(),
         );
         let mut resources = vec![wgpu::BindingResource::TextureView(clouds)];
         resources.extend(behind.map(wgpu::BindingResource::TextureView));

@@ -22,11 +22,12 @@ pub enum GpuError {
 
 /// The iterations after which Mesa's llvmpipe (lavapipe) ends a shader's
 /// loops, all of them together (its `LP_MAX_TGSI_LOOP_ITERATIONS`): the
-/// likely reason, not proven, why at 1024 primary steps or more
-/// lavapipe's picture departs from the CPU twin's (fair weather at 64x48:
-/// 0.1 levels from 48 to 512 steps, 1.3 at 1024, 11 at distant cloud
-/// bases; 0.1 at 1024 without shadow rays, whose weights each lit sample
-/// sums in a loop). README, "Lavapipe at 1024 steps or more".
+/// likely reason, not proven, why lavapipe's picture departs from the
+/// CPU twin's once primary steps times shadow steps pass about 10,000
+/// (fair weather at 64x48: 0.1 levels at 512 x 20 and 1024 x 10, 1.3 at
+/// 1024 x 20, 11 at distant cloud bases; each lit sample also sums its
+/// shadow steps' weights in a loop). README, "Lavapipe at 1024 steps or
+/// more".
 pub const LLVMPIPE_LOOP_ITERATIONS: u32 = 65_535;
 
 /// A device and queue with what the renderer can use.

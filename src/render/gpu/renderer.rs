@@ -66,6 +66,17 @@ pub enum FrameUse {
     CloudsOnly { depth: bool },
 }
 
+/// What the composite of [`CloudRenderer::render`] draws the clouds over:
+/// the scene's terrain where it has one, else the application's colour
+/// where it gives a depth buffer, else the sky.
+fn background(terrain: bool, depth: bool) -> Background {
+    match (terrain, depth) {
+        (true, _) => Background::Terrain,
+        (false, true) => Background::ExternalDepth,
+        (false, false) => Background::Sky,
+    }
+}
+
 /// The wgpu cloud renderer. It sees the simulation only through the
 /// projected field P ([`CloudRenderer::update_field`]).
 ///
@@ -310,41 +321,35 @@ impl CloudRenderer {
     /// [`Self::set_settings`]. [`Self::pipelines`] lists what exists.
     pub fn warm_up(&mut self, uses: &[FrameUse]) {
         let constants = self.settings.constants();
-        let physical = self.inputs.sky.is_some();
         if let Some(l) = &mut self.light {
             l.warm(&self.device, &self.inputs.layout, &constants);
         }
         let light = self.light.as_ref().map(|l| &l.read_layout);
         for u in uses {
-            // As `render` and `render_clouds` choose them.
+            // As `render` and `render_clouds` choose them: `render` marches
+            // to the scene's terrain where it has one.
             let (depth, background) = match *u {
-                FrameUse::Render { depth } => {
-                    let background = match (self.terrain.is_some(), depth) {
-                        (true, _) => Background::Terrain,
-                        (false, true) => Background::ExternalDepth,
-                        (false, false) => Background::Sky,
-                    };
-                    (depth || self.terrain.is_some(), Some(background))
-                }
+                FrameUse::Render { depth } => (
+                    depth || self.terrain.is_some(),
+                    Some(background(self.terrain.is_some(), depth)),
+                ),
                 FrameUse::CloudsOnly { depth } => (depth, None),
             };
             self.clouds.pipeline(
                 &self.device,
-                &self.inputs.layout,
+                &self.inputs,
                 &constants,
                 depth,
                 self.tsaa.is_some(),
-                physical,
                 light,
             );
             if let Some(b) = background {
                 self.composite.pipeline(
                     &self.device,
-                    &self.inputs.layout,
+                    &self.inputs,
                     &constants,
                     self.target_format,
                     b,
-                    physical,
                 );
             }
         }
@@ -545,11 +550,8 @@ impl CloudRenderer {
         let own_depth = self.terrain.as_ref().map(|t| bind::view(&t.depth));
         let resolved = self.record_clouds(&mut rec, &constants, own_depth.as_ref().or(depth));
         let terrain_color = self.terrain.as_ref().map(|t| bind::view(&t.color));
-        let (background, behind) = match (&terrain_color, depth) {
-            (Some(c), _) => (Background::Terrain, Some(c)),
-            (None, Some(d)) => (Background::ExternalDepth, Some(d)),
-            (None, None) => (Background::Sky, None),
-        };
+        let background = background(terrain_color.is_some(), depth.is_some());
+        let behind = terrain_color.as_ref().or(depth);
         self.composite.record(
             &mut rec,
             &self.device,

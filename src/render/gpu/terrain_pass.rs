@@ -133,7 +133,7 @@ impl TerrainPass {
         let (cv, dv) = (bind::view(&self.color), bind::view(&self.depth));
         let reach = terrain_reach(max_distance_m, self.extent_m);
         let instances = (2 * reach + 1).pow(2);
-        let vertices = mesh_vertices(self.size, self.stride(max_distance_m)) as u32;
+        let vertices = mesh_vertices(self.size, mesh_stride(self.size, reach)) as u32;
         let mut pass = rec.begin(
             PASS_TERRAIN,
             &[bind::color_attachment(&cv, Some(wgpu::Color::TRANSPARENT))],
