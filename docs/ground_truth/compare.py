@@ -49,6 +49,7 @@ Debian 12's LLVM 15 makes Dr.Jit fail ("Cannot select: fminimum"); with
 
 import argparse
 import csv
+import hashlib
 import json
 import os
 import subprocess
@@ -262,6 +263,50 @@ def save_cached(path, array):
     os.replace(part, path)
 
 
+# Path-traced references kept in the repository (`--store` writes them):
+# each `KEY.npy` beside `KEY.sha256`, the fingerprint of the exported
+# volume and sky it was rendered from. compare.py reads one only while the
+# export it makes now has the same fingerprint (the same clouds, grid and
+# sky); otherwise it renders anew. 57 kB a view at 80 x 60.
+REFERENCES = os.path.join(HERE, "references")
+
+
+def export_fingerprint(*paths):
+    """SHA-256 over the exported files' bytes (the `.vol` and the sky's
+    `.exr`): what a path-traced reference depends on besides its key."""
+    h = hashlib.sha256()
+    for path in paths:
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+    return h.hexdigest()
+
+
+def stored_reference(key, fingerprint):
+    """The stored reference of `key` when it was rendered from the export
+    of `fingerprint`; None when there is none, or it is of other clouds."""
+    path = os.path.join(REFERENCES, key)
+    try:
+        stored = open(path[:-4] + ".sha256").read().split()[0]
+    except OSError:
+        return None
+    if stored != fingerprint:
+        print(f"{key}: the stored reference is of another export (fingerprint "
+              f"{stored[:12]}, now {fingerprint[:12]}); rendering anew")
+        return None
+    return np.load(path)
+
+
+def store_reference(key, fingerprint, truth):
+    """Writes `truth` into REFERENCES under `key`, with its fingerprint."""
+    path = os.path.join(REFERENCES, key)
+    save_cached(path, truth)
+    part = f"{path[:-4]}.sha256.{os.getpid()}.tmp"
+    with open(part, "w") as f:
+        f.write(fingerprint + "\n")
+    os.replace(part, path[:-4] + ".sha256")
+
+
 def cache_key(name, width, height, spp, cells, suffix=""):
     """The file name a Mitsuba render of view `name` is cached under
     (`--cache`; noise_floor.py, surrogate.py and ground_shadow.py use
@@ -359,6 +404,10 @@ def main():
     ap.add_argument("--cache", default=None,
                     help="keep Mitsuba's renders here and reuse them (only while the "
                          "scene, the density and the export stay the same)")
+    ap.add_argument("--store", action="store_true",
+                    help="keep each Mitsuba render in docs/ground_truth/references with "
+                         "the fingerprint of the export it was rendered from (read back "
+                         "by later runs while the export is the same)")
     ap.add_argument("--single-scattering", action="store_true",
                     help="the sun's light scattered once, nothing else: Mitsuba with one "
                          "scattering and no sky, ours with --single-scattering")
@@ -406,12 +455,18 @@ def main():
             key = cache_key(name, a.width, a.height, a.spp, a.cells,
                             "_single" if a.single_scattering else "")
             cached = os.path.join(a.cache, key) if a.cache else None
-            if cached and os.path.exists(cached):
+            fingerprint = export_fingerprint(vol, sky)
+            stored = stored_reference(key, fingerprint)
+            if stored is not None:
+                truth = stored
+            elif cached and os.path.exists(cached):
                 truth = np.load(cached)
             else:
                 truth = mitsuba_render(vol, sky, side, a.spp, a.width, a.height, a.single_scattering)
                 if cached:
                     save_cached(cached, truth)
+            if a.store and stored is None:
+                store_reference(key, fingerprint, truth)
             cloud, tau, near_sun = cloud_pixels(name, vol, side, a.width, a.height)
             yo, ym = luminance(ours), luminance(truth)
             rel = (yo - ym) / np.maximum(ym, 1e-6)

@@ -11,6 +11,7 @@ pub mod density;
 pub mod exposure;
 pub mod glare;
 pub mod land;
+pub mod light_transport;
 pub mod light_volume;
 pub mod lighting;
 pub mod renderer;
