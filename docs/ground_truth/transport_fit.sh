@@ -14,6 +14,9 @@
 # Environment read by the patched build: CUMULUS_LIGHT_MC (photons for
 # the sun's light; unset: the diffusion), CUMULUS_SKY_MC (photons for the
 # sky's light from above and from below; unset: the shipped profiles),
+# CUMULUS_SUN_SH (photons for the sun's light held as spherical harmonics
+# to l = 2 instead of fluence and flux; CUMULUS_SH_ORDER=1 keeps only
+# l <= 1),
 # CUMULUS_LIGHT_CELL (the grid's cell, m; 80 unset). fit_gains.py's cache
 # is keyed by the binary, not by these: give each setting its own --cache.
 #
