@@ -17,7 +17,11 @@
 # CUMULUS_SUN_SH (photons for the sun's light held as spherical harmonics
 # to l = 2 instead of fluence and flux; CUMULUS_SH_ORDER=1 keeps only
 # l <= 1),
-# CUMULUS_LIGHT_CELL (the grid's cell, m; 80 unset). fit_gains.py's cache
+# CUMULUS_LIGHT_CELL (the grid's cell, m; 80 unset). The sky's and the
+# SH volumes are built lazily by the first pixel that needs them, inside
+# the render's own parallel loop, so on one core while the other waits:
+# 16 M photons at 80 m take about a minute; 64 M at 40 m did not finish a
+# view in 15 minutes and was stopped. fit_gains.py's cache
 # is keyed by the binary, not by these: give each setting its own --cache.
 #
 # Builds the patch (transport_experiment.patch) in a worktree of HEAD at
