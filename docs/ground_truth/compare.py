@@ -52,6 +52,7 @@ import csv
 import hashlib
 import json
 import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -253,6 +254,14 @@ def read_vol(path):
     return np.frombuffer(raw[48:], "<f4").reshape(nz, ny, nx)
 
 
+def exit_on_sigterm():
+    """SIGTERM ends the script as Ctrl-C does, through its `finally`
+    blocks: the temporary scene it wrote into scenes/ is removed and the
+    renderer it waits on is killed (subprocess.run kills it on the way
+    out), rather than left behind."""
+    signal.signal(signal.SIGTERM, lambda signum, _frame: sys.exit(128 + signum))
+
+
 def save_cached(path, array):
     """Writes a cache entry (the `--cache` renders, and the other scripts'
     beside them) whole, then renames it into place: an interrupted run
@@ -418,6 +427,7 @@ def main():
                     help="a [render] key for our renderer and the export, as TOML "
                          "(e.g. --set 'multiple_scattering=\"diffusion\"'); repeatable")
     a = ap.parse_args()
+    exit_on_sigterm()
     extra = {}
     for kv in a.set:
         if "=" not in kv:

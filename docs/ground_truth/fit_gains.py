@@ -108,6 +108,7 @@ def main():
                                     "the others are read back")
 
     a = ap.parse_args()
+    C.exit_on_sigterm()
     held = {}
     for h in a.hold:
         k, _, v = h.partition("=")
