@@ -34,7 +34,7 @@ pub const AUTO_EXPOSURE_MAX: f32 = 1_048_576.0;
 
 /// Rec. 709 luminance of a linear sRGB colour.
 #[inline]
-fn luminance(c: Vec3) -> f32 {
+pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 

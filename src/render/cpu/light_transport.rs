@@ -17,6 +17,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::exposure::luminance;
 use super::light_volume::{DiffusionGrid, LIGHT_SUN_MIN};
 use super::renderer::ALBEDO;
 
@@ -206,8 +207,6 @@ struct Tracks<'a> {
     moment: &'a mut [Vec3],
 }
 
-const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
-
 /// One photon's walk from `start` (a grid position, a direction and an
 /// RGB weight), its tracks added to `tracks` (after its first scattering
 /// with `scattered_only`).
@@ -222,7 +221,7 @@ fn follow(
     let (mut pos, mut dir, colour) = start;
     let h = grid.cell_m;
     let cells = grid.cells.as_ivec3();
-    let lum = colour.dot(LUMINANCE);
+    let lum = luminance(colour);
     let mut weight = 1.0f32;
     let mut scattered = !scattered_only;
     let mut crossed = 0u32;
@@ -339,7 +338,7 @@ mod tests {
         let (grid, sigma) = layer(0.0, 6);
         let sky = Vec3::new(0.2, 0.5, 1.0);
         let (phi, flux) = trace_sky(&grid, &sigma, &|_| sky, true, 400_000, 3);
-        let lum = sky.dot(LUMINANCE);
+        let lum = luminance(sky);
         for j in 0..6 {
             let p = layer_mean(&grid, &phi, j);
             let f = layer_mean(&grid, &flux, j);
