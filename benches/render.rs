@@ -1,5 +1,5 @@
-//! Cloud-map generation, P's spread, the light volume's build and its
-//! three steps, CPU rendering of a 320x240 frame, and the endless
+//! Cloud-map generation, P's spread, the light volume's steps (its
+//! transport per million photons), CPU rendering of a 320x240 frame, and the endless
 //! database's distances between its volumes (beside the doubles they
 //! were summed in until 2026-12-06).
 //!
@@ -9,8 +9,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use cumulus::endless::distances;
 use cumulus::prepare::Prepared;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
+use cumulus::render::cpu::light_transport::trace;
 use cumulus::render::cpu::light_volume::{
-    DiffusionGrid, LIGHT_SWEEPS, LightVolume, cell_extinction, relax_sweeps, sun_depth,
+    DiffusionGrid, LIGHT_SEED, cell_extinction, light_photons, sh_planes,
 };
 use cumulus::render::cpu::renderer::render_linear;
 use cumulus::render::cpu::sky::sun_direction;
@@ -44,20 +45,24 @@ fn render(c: &mut Criterion) {
     let frame = prepared.frame(r, r.quality());
     let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
     let grid = DiffusionGrid::new(&frame.density);
-    c.bench_function("light_volume_build_fair_weather", |b| {
-        b.iter(|| LightVolume::build(&frame.fields, &frame.density, sun))
-    });
     c.bench_function("light_volume_cell_extinction", |b| {
         b.iter(|| cell_extinction(&grid, &frame.fields, &frame.density))
     });
     let sigma = cell_extinction(&grid, &frame.fields, &frame.density);
-    c.bench_function("light_volume_sun_depth", |b| {
-        b.iter(|| sun_depth(&grid, &sigma, sun))
+    // The transport: a build traces `light_photons` (16 M here, about 16
+    // times this million's time); ten samples, each a few seconds.
+    let mut slow = c.benchmark_group("light_volume_slow");
+    slow.sample_size(10);
+    eprintln!(
+        "a build traces {} photons",
+        light_photons(&grid, r.light_photons)
+    );
+    slow.bench_function("light_volume_trace_1m_photons", |b| {
+        b.iter(|| trace(&grid, &sigma, sun, 1 << 20, LIGHT_SEED))
     });
-    let tau = sun_depth(&grid, &sigma, sun);
-    c.bench_function("light_volume_relax_sweeps", |b| {
-        b.iter(|| relax_sweeps(&grid, &sigma, &tau, vec![0.0; grid.len()], LIGHT_SWEEPS))
-    });
+    slow.finish();
+    let sh = trace(&grid, &sigma, sun, 1 << 16, LIGHT_SEED);
+    c.bench_function("light_volume_sh_planes", |b| b.iter(|| sh_planes(&sh)));
     c.bench_function("cpu_render_320x240_fair_weather", |b| {
         b.iter(|| render_linear(320, 240, &frame))
     });

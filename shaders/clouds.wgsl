@@ -76,17 +76,14 @@ const FORWARD_COS_MAX: f32 = 0.9;
 const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.9;
-const MULTIPLE_GAIN: f32 = 0.53;
-const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.46;
+const MULTIPLE_GAIN: f32 = 0.254;
+const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
 const MULTIPLE_SUN_POWER: f32 = 0.2;
-const DIFFUSE_GAIN: f32 = 0.1;
+const DIFFUSE_GAIN: f32 = 0.045;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
-const FLUENCE_GAIN: f32 = 1.19;
-// The phase function's mean cosine (the light volume's diffusion and
-// the diffused light's first-order term).
-const PHASE_MEAN_COSINE: f32 = 0.525;
-const AMBIENT_GAIN: f32 = 4.37;
-const GROUND_LIGHT_GAIN: f32 = 3.82;
+const FLUENCE_GAIN: f32 = 0.766;
+const AMBIENT_GAIN: f32 = 4.626;
+const GROUND_LIGHT_GAIN: f32 = 0.0;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
@@ -492,13 +489,22 @@ fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
     return DIFFUSE_GAIN * max(mu_sun, 0.0) * (1.0 - exp(-sigma_t * DIFFUSE_DEPTH_M)) / (4.0 * PI);
 }
 
-// The light volume's diffused sunlight toward the eye `to_eye` from its
-// fluence `phi` and net flux `flux`, `(φ + 3 g F·ω) / 4π` (the CPU's
-// `diffused_fluence`; `light_at` is the light volume's read, or 0
-// without one).
-fn diffused_fluence(phi: f32, flux: vec3f, to_eye: vec3f) -> f32 {
-    let first_order = 3.0 * PHASE_MEAN_COSINE * dot(flux, to_eye);
-    return FLUENCE_GAIN * max(phi + first_order, 0.0) / (4.0 * PI);
+// The real spherical harmonics to l = 2 at unit `d` (the CPU's `sh9`):
+// (l, m) = (0, 0), (1, -1), (1, 0), (1, 1), (2, -2) ... (2, 2), z the
+// polar axis. The light volume holds the transported sunlight in them
+// (`light_toward` is its read, or 0 without one).
+fn sh9(d: vec3f) -> array<f32, 9> {
+    return array<f32, 9>(
+        0.2820948,
+        0.4886025 * d.y,
+        0.4886025 * d.z,
+        0.4886025 * d.x,
+        1.0925484 * d.x * d.y,
+        1.0925484 * d.y * d.z,
+        0.31539157 * (3.0 * d.z * d.z - 1.0),
+        1.0925484 * d.x * d.z,
+        0.5462742 * (d.x * d.x - d.y * d.y),
+    );
 }
 
 // Single scattering and, when OCTAVES > 0, OCTAVES octaves of multiple
@@ -878,8 +884,7 @@ fn reflected_clouds(p: vec3f, r: vec3f, t_sea: f32, dither: f32, sun_dir: vec3f,
         let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS);
         let tau_sun = -log(max(shadow, 1e-30));
         let eta = clamp((x.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let volume = light_at(x);
-        let diffused = diffused_fluence(volume.x, volume.yzw, -r);
+        let diffused = FLUENCE_GAIN * light_toward(x, -r);
         let scatter = sun * (sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + diffused) + ambient_light(sky_top, ground, eta);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= exp(-sigma_t * h);
@@ -1062,8 +1067,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 lit = false;
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
                 let ambient = ambient_light(sky_top, ground, eta);
-                let volume = light_at(lit_p);
-                let diffused = diffused_fluence(volume.x, volume.yzw, -dir);
+                let diffused = FLUENCE_GAIN * light_toward(lit_p, -dir);
                 let scatter = sun * (sun_scattering(tau, cos_theta, sun_dir.y, lit_sigma) + diffused) + ambient;
                 let s = scatter * (lit_sigma * ALBEDO);
                 let step_t = exp(-lit_sigma * h);

@@ -216,6 +216,7 @@ fn agreement(gpu: &[u8], cpu: &[u8]) -> (f64, f64) {
 fn spheroids_and_cloud_map_draw_the_same_parcels() {
     let Some(ctx) = gpu() else { return };
     let mut sc = Scene::load(std::path::Path::new("scenes/fair_weather.toml")).unwrap();
+    sc.render.light_photons = 16;
     sc.render.tsaa = false;
     // No shadows: the cloud map darkens the ground under its clouds (the
     // baseline does not), and the mask against the clear ground would
@@ -301,6 +302,7 @@ fn spheroids_and_cloud_map_draw_the_same_parcels() {
 fn the_spheroid_renderer_matches_its_cpu_twin() {
     let Some(ctx) = gpu() else { return };
     let mut sc = Scene::load(std::path::Path::new("scenes/spheroids.toml")).unwrap();
+    sc.render.light_photons = 16;
     sc.render.time_s = 600.0;
     let (w, h) = (96, 64);
     sc.render.width = w;
@@ -367,6 +369,7 @@ fn the_spheroid_renderer_matches_its_cpu_twin() {
 fn the_volume_renderer_matches_its_cpu_twin_on_a_blend() {
     let Some(ctx) = gpu() else { return };
     let mut sc = Scene::load(std::path::Path::new("scenes/endless.toml")).unwrap();
+    sc.render.light_photons = 16;
     sc.render.time_s = 600.0;
     let (w, h) = (96, 64);
     sc.render.width = w;

@@ -465,6 +465,8 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
         let out = dir.path().join(name);
         let o = cumulus(&[
             "render",
+            "--light-photons",
+            "16",
             "--scene",
             scene.to_str().unwrap(),
             "--out",
@@ -513,6 +515,8 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
     let out = dir.path().join("gpu.png");
     let args = [
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         scene.to_str().unwrap(),
         "--out",
@@ -550,6 +554,8 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
     assert!(!out.exists());
     let o = cumulus(&[
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         scene.to_str().unwrap(),
         "--out",
@@ -572,6 +578,8 @@ fn render_on_the_gpu_writes_the_png_and_times_frames() {
     let scene = root().join("scenes/fair_weather.toml");
     let o = cumulus(&[
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         scene.to_str().unwrap(),
         "--out",
@@ -697,6 +705,8 @@ fn render_refuses_a_missing_folder_or_a_directory_before_simulating() {
     ] {
         let o = cumulus(&[
             "render",
+            "--light-photons",
+            "16",
             "--scene",
             scene.to_str().unwrap(),
             "--backend",
@@ -725,6 +735,8 @@ fn a_successful_render_prints_no_error_and_one_backend_line() {
     let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
         .args([
             "render",
+            "--light-photons",
+            "16",
             "--scene",
             scene.to_str().unwrap(),
             "--backend",
@@ -831,6 +843,8 @@ fn odd_values_get_clear_errors() {
     let sc = scene.to_str().unwrap();
     let o = cumulus(&[
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         sc,
         "--width",
@@ -849,6 +863,8 @@ fn odd_values_get_clear_errors() {
     std::fs::write(&far, "[render]\ncamera_position_m = [0, 1e9, 0]\n").unwrap();
     let o = cumulus(&[
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         far.to_str().unwrap(),
         "--out",
@@ -953,6 +969,8 @@ fn shipped_scenes_work_outside_the_repository() {
         Command::new(env!("CARGO_BIN_EXE_cumulus"))
             .args([
                 "render",
+                "--light-photons",
+                "16",
                 "--scene",
                 scene,
                 "--backend",
@@ -1025,6 +1043,8 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
     let render = |out: &str| {
         let o = cumulus(&[
             "render",
+            "--light-photons",
+            "16",
             "--scene",
             path.to_str().unwrap(),
             "--backend",
@@ -1061,6 +1081,8 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
     std::fs::write(dir.path().join("sky.volumes"), "not volumes").unwrap();
     let o = cumulus(&[
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         path.to_str().unwrap(),
         "--backend",
@@ -1089,6 +1111,8 @@ fn render_small_cpu(
 ) -> image::RgbImage {
     let mut args = vec![
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         scene.to_str().unwrap(),
         "--out",
@@ -1139,6 +1163,8 @@ fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
     let out = dir.path().join("spheroids.png");
     let o = cumulus(&[
         "render",
+        "--light-photons",
+        "16",
         "--scene",
         root().join("scenes/spheroids.toml").to_str().unwrap(),
         "--out",
@@ -1211,6 +1237,8 @@ fn lavapipe_at_a_thousand_steps_is_warned_about() {
     let run = |steps: &str| {
         let o = cumulus(&[
             "render",
+            "--light-photons",
+            "16",
             "--scene",
             scene.to_str().expect("utf-8"),
             "--out",

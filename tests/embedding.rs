@@ -31,6 +31,9 @@ fn prepared() -> (Scene, Prepared) {
 fn prepared_scene(name: &str) -> (Scene, Prepared) {
     let path = format!("scenes/{name}.toml");
     let mut sc = Scene::load(std::path::Path::new(&path)).expect("shipped scene");
+    // A quick light volume: the scenes' 1024 photons a column take a
+    // minute to build on lavapipe; these tests do not measure the light.
+    sc.render.light_photons = 16;
     sc.render.tsaa = false;
     // The composited picture below is the clouds over the background
     // alone: the glare the composite adds around a sun in view is not

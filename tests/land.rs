@@ -20,6 +20,9 @@ fn lum(c: Vec3) -> f32 {
 /// rendered on the CPU at 64x48 (one march per pixel).
 fn ground_view(land: Land, scene: &str) -> Vec<Vec3> {
     let mut sc = Scene::load(std::path::Path::new(scene)).expect("shipped scene");
+    // A quick light volume: the scenes' 1024 photons a column take a
+    // minute to build on lavapipe; these tests do not measure the light.
+    sc.render.light_photons = 16;
     sc.render.camera_position_m = [5000.0, 400.0, 5000.0];
     sc.render.camera_pitch_deg = -35.0;
     sc.render.ground.land = land;
@@ -68,6 +71,7 @@ fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
     use cumulus::render::cpu::renderer::{Quality, flat_ground_shadow};
     use cumulus::render::cpu::sky::{LAND_ALBEDO, background_radiance, sun_direction};
     let mut sc = Scene::load(std::path::Path::new("scenes/fair_weather.toml")).expect("scene");
+    sc.render.light_photons = 16;
     sc.render.camera_position_m = [5000.0, 400.0, 5000.0];
     let p = Prepared::from_scene(&sc, || {}).expect("prepare");
     let fr = p.frame(&sc.render, sc.render.quality());
@@ -139,6 +143,7 @@ fn the_terrains_level_ground_is_tinted_too() {
 #[test]
 fn the_sea_has_no_fields() {
     let mut sc = Scene::load(std::path::Path::new("scenes/bomex.toml")).expect("scene");
+    sc.render.light_photons = 16;
     assert_eq!(sc.render.ground.surface, Surface::Sea);
     sc.render.ground.land = Land::Fields;
     assert!(!sc.render.quality().land_fields);

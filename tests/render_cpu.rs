@@ -426,6 +426,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
             steps: 2048,
             shadow_steps: 0,
             octaves: 0,
+            light_photons: 0,
             haze_distance_m: 1e9,
             max_distance_m: 1e5,
             exposure: 1.0,
@@ -496,6 +497,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
             steps: 48,
             shadow_steps: 4,
             octaves: 2,
+            light_photons: 64,
             haze_distance_m: 25_000.0,
             max_distance_m: 40_000.0,
             exposure: 1.2,
@@ -527,7 +529,7 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
     let mut fr = small_frame(&p, &cm);
     // Lit as a scene's frame is: with the light volume.
     let sun = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
-    let light = LightVolume::build(&fr.fields, &fr.density, sun);
+    let light = LightVolume::build(&fr.fields, &fr.density, sun, fr.quality.light_photons);
     fr.light = Some(&light);
     let img = render_linear(96, 64, &fr);
     assert!(img.iter().all(|c| c.is_finite()));
@@ -585,6 +587,7 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
     let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
         .expect("shipped scene");
     sc.render.time_s = 1800.0;
+    sc.render.light_photons = 16;
     let p = Prepared::from_scene(&sc, || {}).expect("prepare");
     let r = &sc.render;
     let (w, h) = (96, 72);
@@ -625,6 +628,7 @@ fn averaged_offsets_approach_the_many_step_image() {
     let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
         .expect("shipped scene");
     sc.render.time_s = 1800.0;
+    sc.render.light_photons = 16;
     let p = Prepared::from_scene(&sc, || {}).expect("prepare");
     let r = &sc.render;
     let (w, h) = (96, 72);
@@ -920,6 +924,7 @@ fn the_shade_under_clouds_gets_the_path_tracers_light() {
     let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
         .expect("shipped scene");
     sc.render.atmosphere.aerial_perspective = false;
+    sc.render.light_photons = 16;
     let mut p = Prepared::from_scene(&sc, || {}).expect("prepare");
     for (view, elevation) in [("ground_high_sun", 60.0), ("ground_mid_sun", 30.0)] {
         p.clear_sky();

@@ -13,7 +13,8 @@ use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
 use cumulus::render::cpu::{
-    density, glare, land, light_volume, lighting, renderer, sea, sky, sky_luts, waves,
+    density, glare, land, light_transport, light_volume, lighting, renderer, sea, sky, sky_luts,
+    waves,
 };
 use cumulus::render::gpu::light_volume_pass::{self, DiffusionGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
@@ -55,6 +56,9 @@ const GPU_ONLY: &[(&str, &str)] = &[
         "light_invocation",
         "a folded dispatch's cell (workgroups())",
     ),
+    // The photons' random numbers: the CPU's Rng::new and Rng::next.
+    ("rng_seed", "Rng::new"),
+    ("rng_next", "Rng::next"),
 ];
 
 /// Every WGSL constant and its Rust twin's value.
@@ -223,17 +227,16 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ),
         ("SKY_AMBIENT_ROWS", sky_luts::SKY_AMBIENT_SAMPLES.0 as f64),
         ("FLUENCE_GAIN", lighting::FLUENCE_GAIN as f64),
-        ("LIGHT_RELAXATION", light_volume::LIGHT_RELAXATION as f64),
-        ("PHASE_MEAN_COSINE", light_volume::PHASE_MEAN_COSINE as f64),
-        ("AIR_TRANSPORT_M", light_volume::AIR_TRANSPORT_M as f64),
-        ("CLEAR_AIR_LOSS_M", light_volume::CLEAR_AIR_LOSS_M as f64),
-        (
-            "CLOUD_EXTINCTION_MIN",
-            light_volume::CLOUD_EXTINCTION_MIN as f64,
-        ),
         ("LIGHT_SUN_MIN", light_volume::LIGHT_SUN_MIN as f64),
-        ("LIGHT_DEPTH_NONE", light_volume::LIGHT_DEPTH_NONE as f64),
-        ("FLUX_LIMIT", light_volume::FLUX_LIMIT as f64),
+        ("LIGHT_SEED", light_volume::LIGHT_SEED as f64),
+        (
+            "CELLS_PER_PHOTON_MAX",
+            light_transport::CELLS_PER_PHOTON_MAX as f64,
+        ),
+        ("ROULETTE_WEIGHT", light_transport::ROULETTE_WEIGHT as f64),
+        ("TRACK_UNIT", light_volume_pass::TRACK_UNIT as f64),
+        ("PHASE_MOMENT_1", light_transport::PHASE_MOMENTS[1] as f64),
+        ("PHASE_MOMENT_2", light_transport::PHASE_MOMENTS[2] as f64),
         ("LIGHT_WORKGROUP", light_volume_pass::LIGHT_WORKGROUP as f64),
         (
             "SKY_AMBIENT_COLUMNS",

@@ -116,6 +116,9 @@ fn cloud_renderer(
         world.terrain.as_ref(),
     );
     clouds.update_field(&ctx.queue, &world.field);
+    // The clouds change as the demo runs: the light volume follows them a
+    // batch of photons a frame instead of a whole build per change.
+    clouds.set_progressive_light(true);
     clouds.resize(width, height);
     // The window's first frame would otherwise compile them.
     clouds.warm_up(&[FrameUse::Render { depth: false }]);

@@ -35,6 +35,12 @@ pub struct BenchArgs {
     /// per frame, s (default 20; 2 with --quick).
     #[arg(long)]
     max_frame_s: Option<f64>,
+    /// Photons the light volume traces per column of its cells (overrides
+    /// render.light_photons; 16 with --quick, where software Vulkan would
+    /// spend a minute on each configuration's first build). The build runs
+    /// before the timed frames, which it does not change.
+    #[arg(long)]
+    light_photons: Option<u32>,
 }
 
 pub fn run(a: BenchArgs) -> Result<()> {
@@ -42,6 +48,13 @@ pub fn run(a: BenchArgs) -> Result<()> {
     let mut scene = load_scene(&a.scene)?;
     if a.quick {
         scene.render.time_s = scene.render.time_s.min(600.0);
+        scene.render.light_photons = scene.render.light_photons.min(16);
+    }
+    if let Some(n) = a.light_photons {
+        scene.render.light_photons = n;
+        scene
+            .validate()
+            .with_context(|| format!("--light-photons {n}"))?;
     }
     let ctx = gpu_context().context("cumulus bench needs a GPU adapter")?;
     eprintln!("device: {}", ctx.describe());

@@ -47,6 +47,11 @@ pub struct RenderArgs {
     /// Primary ray-march steps (overrides render.steps).
     #[arg(long)]
     steps: Option<u32>,
+    /// Photons the light volume traces per column of its cells (overrides
+    /// render.light_photons, default 1024): fewer for a quick preview
+    /// (the multiply scattered light is noisier), 0 for none.
+    #[arg(long)]
+    light_photons: Option<u32>,
     /// auto: a hardware GPU when wgpu finds one, else the CPU reference;
     /// cpu; gpu (any adapter wgpu finds, software Vulkan included).
     /// WGPU_BACKEND (vulkan, gl, metal, dx12) narrows the search.
@@ -112,6 +117,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ("--height", "render.height"),
         ("--time-s", "render.time_s"),
         ("--steps", "render.steps"),
+        ("--light-photons", "render.light_photons"),
     ];
     let scene = with_overrides(load_scene(&a.scene)?, &flags, |s| {
         let r = &mut s.render;
@@ -126,6 +132,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
         if let Some(steps) = a.steps {
             r.steps = steps;
+        }
+        if let Some(n) = a.light_photons {
+            r.light_photons = n;
         }
     })?;
     for w in cumulus::prepare::view_warnings(&scene)? {

@@ -1,16 +1,19 @@
 //! The sunlight scattered more than once, by Monte Carlo transport on the
-//! light volume's grid: photons enter through the band's top along the
-//! sun, fly through the cells' extinction (free paths sampled exactly in
-//! the piecewise constant medium, cell by cell), scatter by the renderer's
-//! phase function with its albedo, and leave through the band's top or
-//! floor. Every flight after the first scattering is added to the cells
-//! it crosses (the track-length estimator): its length to the fluence,
-//! its length times its direction to the net flux. The result is the
-//! same pair [`super::light_volume::LightVolume`] holds, the fluence and
-//! flux of the sunlight scattered at least once, per unit sun irradiance,
-//! without the diffusion approximation: forward scattering, the light
-//! that crosses clear air from one cloud to another and a cloud's thin
-//! edges are transported as they are.
+//! light volume's grid (the renderers' light volume,
+//! [`super::light_volume::LightVolume`]; `shaders/light_transport.wgsl` is
+//! the GPU's twin, same names). Photons enter through the band's top
+//! along the sun, fly through the cells' extinction (free paths sampled
+//! exactly in the piecewise constant medium, cell by cell), scatter by the
+//! renderer's phase function with its albedo, and leave through the
+//! band's top or floor. Every flight after the first scattering is added
+//! to the cells it crosses (the track-length estimator): its length times
+//! the real spherical harmonics to l = 2 of its direction ([`sh9`]). Per
+//! cell that is the radiance of the sunlight scattered at least once, per
+//! unit sun irradiance, as nine coefficients, without the diffusion
+//! approximation: forward scattering, the light that crosses clear air
+//! from one cloud to another and a cloud's thin edges are transported as
+//! they are, and the second order keeps the light's forward peak
+//! (docs/ground_truth, 2026-12-06: the backlit view needs it).
 
 use std::f32::consts::PI;
 
@@ -22,18 +25,21 @@ use super::light_volume::{DiffusionGrid, LIGHT_SUN_MIN};
 use super::renderer::ALBEDO;
 
 /// A photon's random numbers: a 32-bit PCG stream (O'Neill's RXS-M-XS
-/// output), seeded per photon; 32 bits so that WGSL draws the same.
-struct Rng(u32);
+/// output), seeded per photon; 32 bits so that WGSL draws the same
+/// (`rng_seed`, `rng_next`).
+pub struct Rng(u32);
 
 impl Rng {
-    fn new(photon: u32, seed: u32) -> Self {
+    /// The stream of photon `photon` under `seed` (`rng_seed` in WGSL).
+    pub fn new(photon: u32, seed: u32) -> Self {
         let mut r = Self(photon ^ seed.wrapping_mul(0x9E37_79B9));
         r.next();
         r
     }
 
-    /// Uniform in `[0, 1)`.
-    fn next(&mut self) -> f32 {
+    /// Uniform in `[0, 1)` (`rng_next` in WGSL).
+    #[allow(clippy::should_implement_trait)]
+    pub fn next(&mut self) -> f32 {
         self.0 = self.0.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
         let s = self.0;
         let word = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277_803_737);
@@ -43,7 +49,8 @@ impl Rng {
 }
 
 /// A cosine drawn from the Henyey-Greenstein phase of asymmetry `g`.
-fn sample_hg(g: f32, u: f32) -> f32 {
+#[inline]
+pub fn sample_hg(g: f32, u: f32) -> f32 {
     if g.abs() < 1e-3 {
         return 1.0 - 2.0 * u;
     }
@@ -51,50 +58,119 @@ fn sample_hg(g: f32, u: f32) -> f32 {
     ((1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
 }
 
+/// Two unit vectors square to unit `d` and to each other (Duff et al.
+/// 2017's branchless basis).
+#[inline]
+pub fn orthonormal_pair(d: Vec3) -> (Vec3, Vec3) {
+    let sign = if d.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + d.z);
+    let b = d.x * d.y * a;
+    (
+        Vec3::new(1.0 + sign * d.x * d.x * a, sign * b, -sign * d.x),
+        Vec3::new(b, sign + d.y * d.y * a, -d.y),
+    )
+}
+
 /// A direction scattered from `dir` by the dual lobe
 /// ([`super::lighting::phase_dual`] at full eccentricity).
-fn scatter(dir: Vec3, rng: &mut Rng) -> Vec3 {
+pub fn scatter(dir: Vec3, rng: &mut Rng) -> Vec3 {
     let g = if rng.next() < 0.75 { 0.8 } else { -0.3 };
     let cos = sample_hg(g, rng.next());
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
     let phi = 2.0 * PI * rng.next();
-    let (a, b) = dir.any_orthonormal_pair();
+    let (a, b) = orthonormal_pair(dir);
     (dir * cos + (a * phi.cos() + b * phi.sin()) * sin).normalize()
 }
 
-/// The most cells one photon crosses before it is dropped: a flight
-/// nearly level in clear air would otherwise circle the repeating domain.
-const CELLS_PER_PHOTON_MAX: u32 = 20_000;
-/// The weight under which Russian roulette may end a photon.
-const ROULETTE_WEIGHT: f32 = 0.1;
+/// The real spherical harmonics to l = 2 at unit `d`, in the order
+/// (l, m) = (0, 0), (1, -1), (1, 0), (1, 1), (2, -2) … (2, 2), with `z`
+/// as the polar axis (`sh9` in WGSL).
+#[inline]
+pub fn sh9(d: Vec3) -> [f32; 9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_094_8,
+        0.488_602_5 * y,
+        0.488_602_5 * z,
+        0.488_602_5 * x,
+        1.092_548_4 * x * y,
+        1.092_548_4 * y * z,
+        0.315_391_57 * (3.0 * z * z - 1.0),
+        1.092_548_4 * x * z,
+        0.546_274_2 * (x * x - y * y),
+    ]
+}
 
-/// The fluence and the net flux of the sunlight scattered at least once,
-/// per cell of `grid` and per unit sun irradiance, from `photons` photons
-/// (seeded by `seed`) under the sun `sun_dir` through the cells'
-/// extinction `sigma`. Under a sun below [`LIGHT_SUN_MIN`], nothing.
+/// The band `l` of each of [`sh9`]'s coefficients.
+pub const SH_BAND: [usize; 9] = [0, 1, 1, 1, 2, 2, 2, 2, 2];
+
+/// The dual-lobe phase's Legendre moments for l = 0, 1, 2:
+/// `0.75 · 0.8^l + 0.25 · (-0.3)^l`. Light of radiance coefficients
+/// `L_lm` scatters toward `ω` as `Σ PHASE_MOMENTS[l] L_lm Y_lm(ω)` per
+/// unit scattering coefficient (Funk-Hecke).
+pub const PHASE_MOMENTS: [f32; 3] = [1.0, 0.525, 0.5025];
+
+/// The fluence (`∫ L dω`) of radiance coefficients `c`.
+#[inline]
+pub fn sh_fluence(c: &[f32; 9]) -> f32 {
+    c[0] / 0.282_094_8
+}
+
+/// The net flux (`∫ L ω dω`) of radiance coefficients `c`.
+#[inline]
+pub fn sh_flux(c: &[f32; 9]) -> Vec3 {
+    Vec3::new(c[3], c[1], c[2]) / 0.488_602_5
+}
+
+/// The most cells one photon crosses before it is dropped: a flight
+/// nearly level in clear air would otherwise circle the repeating domain
+/// (`CELLS_PER_PHOTON_MAX` in WGSL).
+pub const CELLS_PER_PHOTON_MAX: u32 = 20_000;
+/// The weight under which Russian roulette may end a photon
+/// (`ROULETTE_WEIGHT` in WGSL).
+pub const ROULETTE_WEIGHT: f32 = 0.1;
+
+/// Where photon `photon` (seeded by `seed`) enters the band's top under
+/// the sun `sun_dir`: a grid position (in cells) and its direction
+/// (`sun_photon` in WGSL).
+#[inline]
+pub fn sun_photon(grid: &DiffusionGrid, sun_dir: Vec3, rng: &mut Rng) -> (Vec3, Vec3) {
+    let cells = grid.cells.as_vec3();
+    let pos = Vec3::new(rng.next() * cells.x, cells.y - 1e-4, rng.next() * cells.z);
+    (pos, -sun_dir)
+}
+
+/// What each photon's track length is multiplied by to make the
+/// radiance coefficients per unit sun irradiance: each of `photons`
+/// carries the power `μ A / N` through the domain's top of area `A`; the
+/// radiance is the track length per volume (`transport_scale`, twin of
+/// the GPU's).
+pub fn transport_scale(grid: &DiffusionGrid, sun_dir: Vec3, photons: u32) -> f32 {
+    sun_dir.y * area(grid) / photons.max(1) as f32 / volume(grid)
+}
+
+/// The radiance of the sunlight scattered at least once, as [`sh9`]
+/// coefficients per cell of `grid` and per unit sun irradiance, from
+/// `photons` photons (seeded by `seed`) under the sun `sun_dir` through
+/// the cells' extinction `sigma`. Under a sun below [`LIGHT_SUN_MIN`],
+/// nothing.
 pub fn trace(
     grid: &DiffusionGrid,
     sigma: &[f32],
     sun_dir: Vec3,
     photons: u32,
     seed: u32,
-) -> (Vec<f32>, Vec<Vec3>) {
+) -> Vec<[f32; 9]> {
     let n = grid.len();
     if sun_dir.y < LIGHT_SUN_MIN || photons == 0 {
-        return (vec![0.0; n], vec![Vec3::ZERO; n]);
+        return vec![[0.0; 9]; n];
     }
-    let cells = grid.cells.as_vec3();
-    let (length, moment) = run(grid, sigma, photons, seed, true, &|rng: &mut Rng| {
-        let pos = Vec3::new(rng.next() * cells.x, cells.y - 1e-4, rng.next() * cells.z);
-        (pos, -sun_dir, Vec3::ONE)
+    let (_, sh) = run(grid, sigma, photons, seed, true, &|rng: &mut Rng| {
+        let (pos, dir) = sun_photon(grid, sun_dir, rng);
+        (pos, dir, Vec3::ONE)
     });
-    // Each photon carries the power μ A / N through the domain's top of
-    // area A; the fluence is the track length per volume.
-    let scale = sun_dir.y * area(grid) / photons as f32 / volume(grid);
-    (
-        length.iter().map(|l| l.x * scale).collect(),
-        moment.iter().map(|m| *m * scale).collect(),
-    )
+    let scale = transport_scale(grid, sun_dir, photons);
+    sh.iter().map(|c| c.map(|v| v * scale)).collect()
 }
 
 fn area(grid: &DiffusionGrid) -> f32 {
@@ -106,11 +182,14 @@ fn volume(grid: &DiffusionGrid) -> f32 {
     grid.cell_m.x * grid.cell_m.y * grid.cell_m.z
 }
 
-/// The fluence (RGB) and the net flux (of the luminance) of the light of
-/// an environment of radiance `radiance(u)` from direction `u`, entering
-/// the band through its top (from the upper hemisphere) or its floor
-/// (`from_top` false: the lower), all orders of scattering and the
-/// unscattered light.
+/// The fluence (RGB) and the radiance coefficients (of the luminance,
+/// [`sh9`]) of the light of an environment of radiance `radiance(u)` from
+/// direction `u`, entering the band through its top (from the upper
+/// hemisphere) or its floor (`from_top` false: the lower), all orders of
+/// scattering and the unscattered light. Not used by the renderers (the
+/// sky's light in cloud is a profile, `renderer::ambient_light`): the
+/// ground-truth study measured it (docs/ground_truth, 2026-12-06), and
+/// the tests check the estimator's scale with it.
 pub fn trace_sky(
     grid: &DiffusionGrid,
     sigma: &[f32],
@@ -118,9 +197,9 @@ pub fn trace_sky(
     from_top: bool,
     photons: u32,
     seed: u32,
-) -> (Vec<Vec3>, Vec<Vec3>) {
+) -> (Vec<Vec3>, Vec<[f32; 9]>) {
     let cells = grid.cells.as_vec3();
-    let (length, moment) = run(grid, sigma, photons, seed, false, &|rng: &mut Rng| {
+    let (length, sh) = run(grid, sigma, photons, seed, false, &|rng: &mut Rng| {
         // Cosine-weighted about the inward normal.
         let r = rng.next().sqrt();
         let phi = 2.0 * PI * rng.next();
@@ -134,19 +213,21 @@ pub fn trace_sky(
         let pos = Vec3::new(rng.next() * cells.x, y, rng.next() * cells.z);
         (pos, inward, radiance(-inward) * PI)
     });
-    let scale = area(grid) / photons as f32 / volume(grid);
+    let scale = area(grid) / photons.max(1) as f32 / volume(grid);
     (
         length.iter().map(|l| *l * scale).collect(),
-        moment.iter().map(|m| *m * scale).collect(),
+        sh.iter().map(|c| c.map(|v| v * scale)).collect(),
     )
 }
 
+/// A photon's start: a grid position, a direction and an RGB weight.
 type Start<'a> = dyn Fn(&mut Rng) -> (Vec3, Vec3, Vec3) + Sync + 'a;
 
-/// `photons` walks from `start` (a grid position, a direction and an RGB
-/// weight), their tracks summed per cell (after the first scattering
-/// with `scattered_only`): the lengths times the weight, and the lengths
-/// times the direction and the weight's luminance.
+/// `photons` walks from `start`, their tracks summed per cell (after the
+/// first scattering with `scattered_only`): the lengths times the RGB
+/// weight (only where `scattered_only` is false: the sun's light is
+/// white), and the lengths times [`sh9`] of the direction and the
+/// weight's luminance.
 fn run(
     grid: &DiffusionGrid,
     sigma: &[f32],
@@ -154,69 +235,68 @@ fn run(
     seed: u32,
     scattered_only: bool,
     start: &Start,
-) -> (Vec<Vec3>, Vec<Vec3>) {
+) -> (Vec<Vec3>, Vec<[f32; 9]>) {
     let n = grid.len();
+    let colours = if scattered_only { 0 } else { n };
     let chunk = photons.div_ceil(CHUNKS).max(1);
     let chunks = photons.div_ceil(chunk);
-    let mut length = vec![Vec3::ZERO; n];
-    let mut moment = vec![Vec3::ZERO; n];
-    // Chunks traced in parallel a batch at a time and summed in their
-    // order: the same light from the same seed on any number of threads.
-    for batch in (0..chunks).step_by(CHUNKS_AT_ONCE as usize) {
-        let parts: Vec<_> = (batch..(batch + CHUNKS_AT_ONCE).min(chunks))
+    let mut length = vec![Vec3::ZERO; colours];
+    let mut sh = vec![[0.0f32; 9]; n];
+    // Chunks traced in parallel a batch (one per thread) at a time and
+    // summed in their order: the same light from the same seed on any
+    // number of threads.
+    let at_once = rayon::current_num_threads().max(1) as u32;
+    for batch in (0..chunks).step_by(at_once as usize) {
+        let parts: Vec<_> = (batch..(batch + at_once).min(chunks))
             .into_par_iter()
             .map(|c| {
-                let mut length = vec![Vec3::ZERO; n];
-                let mut moment = vec![Vec3::ZERO; n];
+                let mut tracks = Tracks {
+                    length: vec![Vec3::ZERO; colours],
+                    sh: vec![[0.0f32; 9]; n],
+                };
                 for p in c * chunk..((c + 1) * chunk).min(photons) {
                     let mut rng = Rng::new(p, seed);
-                    let (pos, dir, colour) = start(&mut rng);
-                    let tracks = Tracks {
-                        length: &mut length,
-                        moment: &mut moment,
-                    };
-                    follow(
-                        grid,
-                        sigma,
-                        (pos, dir, colour),
-                        scattered_only,
-                        &mut rng,
-                        tracks,
-                    );
+                    let start = start(&mut rng);
+                    follow(grid, sigma, start, scattered_only, &mut rng, &mut tracks);
                 }
-                (length, moment)
+                tracks
             })
             .collect();
-        for (l, m) in parts {
-            length.iter_mut().zip(&l).for_each(|(a, b)| *a += *b);
-            moment.iter_mut().zip(&m).for_each(|(a, b)| *a += *b);
+        for t in parts {
+            length.iter_mut().zip(&t.length).for_each(|(a, b)| *a += *b);
+            for (a, b) in sh.iter_mut().zip(&t.sh) {
+                for k in 0..9 {
+                    a[k] += b[k];
+                }
+            }
         }
     }
-    (length, moment)
+    (length, sh)
 }
 
-/// The photons are traced in this many chunks, [`CHUNKS_AT_ONCE`] at a
-/// time, each into its own copy of the cells.
+/// The photons are traced in this many chunks, one per thread at a time,
+/// each into its own copy of the cells.
 const CHUNKS: u32 = 64;
-const CHUNKS_AT_ONCE: u32 = 8;
 
-/// Where a walk adds its tracks: per cell, the lengths times the weight
-/// and the lengths times the direction and the weight's luminance.
-struct Tracks<'a> {
-    length: &'a mut [Vec3],
-    moment: &'a mut [Vec3],
+/// Where a walk adds its tracks: per cell, the lengths times the RGB
+/// weight (empty when not asked for), and the lengths times [`sh9`] of
+/// the direction and the weight's luminance.
+struct Tracks {
+    length: Vec<Vec3>,
+    sh: Vec<[f32; 9]>,
 }
 
 /// One photon's walk from `start` (a grid position, a direction and an
 /// RGB weight), its tracks added to `tracks` (after its first scattering
-/// with `scattered_only`).
+/// with `scattered_only`; `follow` in WGSL, which adds them to fixed-point
+/// cells).
 fn follow(
     grid: &DiffusionGrid,
     sigma: &[f32],
     start: (Vec3, Vec3, Vec3),
     scattered_only: bool,
     rng: &mut Rng,
-    tracks: Tracks,
+    tracks: &mut Tracks,
 ) {
     let (mut pos, mut dir, colour) = start;
     let h = grid.cell_m;
@@ -239,7 +319,6 @@ fn follow(
                 return;
             }
             let idx = grid.index(cell.x, cell.y, cell.z);
-            // Distance (m) to the cell's faces along `dir`.
             let mut exit = f32::INFINITY;
             let mut axis = 0;
             for a in 0..3 {
@@ -270,8 +349,14 @@ fn follow(
                 return;
             }
             if scattered {
-                tracks.length[idx] += colour * (weight * travel);
-                tracks.moment[idx] += dir * (weight * travel * lum);
+                if !tracks.length.is_empty() {
+                    tracks.length[idx] += colour * (weight * travel);
+                }
+                let y = sh9(dir);
+                let c = &mut tracks.sh[idx];
+                for k in 0..9 {
+                    c[k] += y[k] * (weight * travel * lum);
+                }
             }
             pos += dir * travel / h;
             if !pos.is_finite() {
@@ -280,7 +365,7 @@ fn follow(
             if hit {
                 break;
             }
-            // Step just past the face, and wrap across the domain.
+            // Onto the next cell, across the face it left by.
             pos[axis] = if dir[axis] > 0.0 {
                 cell[axis] as f32 + 1.0
             } else {
@@ -330,6 +415,14 @@ mod tests {
         values[j * n..(j + 1) * n].iter().copied().sum::<T>() / n as f32
     }
 
+    fn fluences(sh: &[[f32; 9]]) -> Vec<f32> {
+        sh.iter().map(sh_fluence).collect()
+    }
+
+    fn fluxes(sh: &[[f32; 9]]) -> Vec<Vec3> {
+        sh.iter().map(sh_flux).collect()
+    }
+
     #[test]
     fn clear_air_under_a_uniform_sky_holds_its_radiance() {
         // Radiance L from every direction of the upper hemisphere: the
@@ -337,7 +430,8 @@ mod tests {
         // height (nothing scatters or absorbs it).
         let (grid, sigma) = layer(0.0, 6);
         let sky = Vec3::new(0.2, 0.5, 1.0);
-        let (phi, flux) = trace_sky(&grid, &sigma, &|_| sky, true, 400_000, 3);
+        let (phi, sh) = trace_sky(&grid, &sigma, &|_| sky, true, 400_000, 3);
+        let flux = fluxes(&sh);
         let lum = luminance(sky);
         for j in 0..6 {
             let p = layer_mean(&grid, &phi, j);
@@ -351,8 +445,8 @@ mod tests {
             assert!(f.x.abs().max(f.z.abs()) < 0.02 * PI * lum, "layer {j}: {f}");
         }
         // From below instead, the flux points up.
-        let (_, flux) = trace_sky(&grid, &sigma, &|_| sky, false, 100_000, 4);
-        assert!(layer_mean(&grid, &flux, 3).y > 0.99 * PI * lum);
+        let (_, sh) = trace_sky(&grid, &sigma, &|_| sky, false, 100_000, 4);
+        assert!(layer_mean(&grid, &fluxes(&sh), 3).y > 0.99 * PI * lum);
     }
 
     #[test]
@@ -364,7 +458,8 @@ mod tests {
         // layer of 50 m deeper keeps e^{-50 κ} = 0.70 of the light.
         let sigma_t = 0.06;
         let (grid, sigma) = layer(sigma_t, 24);
-        let (phi, flux) = trace(&grid, &sigma, Vec3::Y, 400_000, 5);
+        let sh = trace(&grid, &sigma, Vec3::Y, 400_000, 5);
+        let (phi, flux) = (fluences(&sh), fluxes(&sh));
         let kappa = sigma_t * (3.0 * (1.0 - ALBEDO) * (1.0 - 0.525_f32)).sqrt();
         // Layers 9-15: 450-750 m from the top (optical depth 27-45),
         // 450 m and more from the floor.
@@ -384,9 +479,9 @@ mod tests {
         let (grid, sigma) = layer(0.02, 4);
         let low = Vec3::new(1.0, 0.5 * LIGHT_SUN_MIN, 0.0).normalize();
         for (sun, photons) in [(low, 1000), (Vec3::Y, 0)] {
-            let (phi, flux) = trace(&grid, &sigma, sun, photons, 1);
-            assert!(phi.iter().all(|p| *p == 0.0));
-            assert!(flux.iter().all(|f| *f == Vec3::ZERO));
+            let sh = trace(&grid, &sigma, sun, photons, 1);
+            assert_eq!(sh.len(), grid.len());
+            assert!(sh.iter().flatten().all(|c| *c == 0.0));
         }
     }
 
@@ -399,6 +494,81 @@ mod tests {
         let b = trace(&grid, &sigma, sun, 20_000, 9);
         assert_eq!(a, b);
         let c = trace(&grid, &sigma, sun, 20_000, 10);
-        assert_ne!(a.0, c.0);
+        assert_ne!(a, c);
+    }
+
+    /// `∫ f(ω) dω` over the sphere, by the midpoint rule in cos θ and φ.
+    fn sphere_integral(f: impl Fn(Vec3) -> f64) -> f64 {
+        let (nu, nphi) = (400, 800);
+        let mut s = 0.0;
+        for i in 0..nu {
+            let z = -1.0 + (i as f64 + 0.5) * 2.0 / nu as f64;
+            let r = (1.0 - z * z).sqrt();
+            for k in 0..nphi {
+                let phi = (k as f64 + 0.5) * 2.0 * std::f64::consts::PI / nphi as f64;
+                let d = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
+                s += f(d);
+            }
+        }
+        s * 4.0 * std::f64::consts::PI / (nu * nphi) as f64
+    }
+
+    #[test]
+    fn the_harmonics_are_orthonormal() {
+        for i in 0..9 {
+            for j in 0..9 {
+                let v = sphere_integral(|d| (sh9(d)[i] * sh9(d)[j]) as f64);
+                let expected = if i == j { 1.0 } else { 0.0 };
+                assert!((v - expected).abs() < 1e-3, "<Y{i}, Y{j}> = {v}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_phase_moments_are_the_dual_lobe_s() {
+        // p_l = 2π ∫ p(μ) P_l(μ) dμ for the phase the photons scatter by.
+        use crate::render::cpu::lighting::phase_dual;
+        let legendre = [|_: f64| 1.0, |m: f64| m, |m: f64| 0.5 * (3.0 * m * m - 1.0)];
+        for (l, p) in legendre.iter().enumerate() {
+            let n = 200_000;
+            let m: f64 = (0..n)
+                .map(|i| {
+                    let mu = -1.0 + (i as f64 + 0.5) * 2.0 / n as f64;
+                    phase_dual(mu as f32, 1.0) as f64 * p(mu) * 2.0 * std::f64::consts::PI * 2.0
+                        / n as f64
+                })
+                .sum();
+            assert!((m - PHASE_MOMENTS[l] as f64).abs() < 2e-3, "l = {l}: {m}");
+        }
+        // Through the addition theorem, a beam of coefficients `Y(b)`
+        // scatters toward `w` as `Σ_l p_l (2l + 1) / 4π P_l(b · w)`: the
+        // harmonics' order and signs are consistent.
+        for (b, w) in [
+            (Vec3::Y, Vec3::X),
+            (Vec3::new(0.3, -0.8, 0.52).normalize(), Vec3::new(-0.6, 0.1, 0.79).normalize()),
+            (Vec3::Z, Vec3::new(0.0, 0.6, 0.8)),
+        ] {
+            let (yb, yw) = (sh9(b), sh9(w));
+            let got: f32 = (0..9).map(|k| PHASE_MOMENTS[SH_BAND[k]] * yb[k] * yw[k]).sum();
+            let mu = b.dot(w) as f64;
+            let expected: f64 = (0..3)
+                .map(|l| {
+                    PHASE_MOMENTS[l] as f64 * (2 * l + 1) as f64 * legendre[l](mu)
+                        / (4.0 * std::f64::consts::PI)
+                })
+                .sum();
+            assert!((got as f64 - expected).abs() < 1e-5, "{b} {w}: {got} vs {expected}");
+        }
+    }
+
+    #[test]
+    fn the_basis_is_orthonormal_and_square_to_the_direction() {
+        for d in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.8, 0.52).normalize()] {
+            let (a, b) = orthonormal_pair(d);
+            for (u, v) in [(a, b), (a, d), (b, d)] {
+                assert!(u.dot(v).abs() < 1e-5);
+            }
+            assert!((a.length() - 1.0).abs() < 1e-5 && (b.length() - 1.0).abs() < 1e-5);
+        }
     }
 }

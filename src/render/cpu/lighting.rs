@@ -7,7 +7,6 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::density::{DensityParams, Fields, density_at, height_fraction, smoothstep};
-use super::light_volume::PHASE_MEAN_COSINE;
 use crate::render::sampling::GOLDEN;
 
 /// Henyey-Greenstein phase function, 1/sr; integrates to 1 over the sphere.
@@ -218,12 +217,12 @@ pub const OCTAVE_ECCENTRICITY: f32 = 0.9;
 /// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`],
 /// [`FLUENCE_GAIN`] and the sky's and the ground's gains are;
 /// docs/ground_truth).
-pub const MULTIPLE_GAIN: f32 = 0.53;
+pub const MULTIPLE_GAIN: f32 = 0.254;
 /// The gain on the octaves' isotropic light: light scattered many times
 /// leaves a cloud in every direction, not only in the phase's lobes. It
 /// was 0.91 before the light volume, which now carries most of that
 /// light ([`FLUENCE_GAIN`]).
-pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.46;
+pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
 /// The octaves scale with the sun's height as
 /// `sin(elevation)^MULTIPLE_SUN_POWER`. It was 0.4 from before the light
 /// volume, when the octaves also stood for the light a whole layer takes
@@ -243,7 +242,7 @@ pub const MULTIPLE_SUN_POWER: f32 = 0.2;
 /// beside the light volume the free fit takes it to 0, for 0.16 points
 /// of summed error, but the renderers that build no light volume (the
 /// spheroids' and the volume's) have only this to fill deep cloud.
-pub const DIFFUSE_GAIN: f32 = 0.1;
+pub const DIFFUSE_GAIN: f32 = 0.045;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
 /// cloud, not the thin haze and wisps between clouds, which have little
@@ -266,29 +265,14 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
     DIFFUSE_GAIN * mu_sun.max(0.0) * (1.0 - (-sigma_t * DIFFUSE_DEPTH_M).exp()) / (4.0 * PI)
 }
 
-/// The gain on the light volume's diffused sunlight
-/// ([`diffused_fluence`]; `FLUENCE_GAIN` in WGSL), fitted with the
-/// others: 1.19 (1.23 before the rounded tops of 2026-12-05), where an
-/// exact diffusion would need 1. It was 0.9 while
-/// clear air absorbed the light within a cell (1.06 before the flux's
-/// first-order term; the unscaled source, `e^{-τ}`, asked for 2.1); the
-/// light volume's cells, 80 m, still blur a cloud's lit surface into
-/// its shaded inside.
-pub const FLUENCE_GAIN: f32 = 1.19;
-
-/// The sunlight diffused through the clouds, scattered toward the eye per
-/// unit scattering coefficient and per unit sun irradiance, from the
-/// light volume's fluence `phi` and net flux `flux`
-/// ([`super::light_volume::LightVolume`]) toward the eye `to_eye`: the
-/// first-order radiance `(φ + 3 F·ω) / 4π` scattered by a phase of mean
-/// cosine `g` is `(φ + 3 g F·ω) / 4π`, times [`FLUENCE_GAIN`]. The flux
-/// term brightens the faces the diffused light leaves through (a backlit
-/// cloud's shaded side, a base seen from under it) over those it enters.
-#[inline]
-pub fn diffused_fluence(phi: f32, flux: Vec3, to_eye: Vec3) -> f32 {
-    let first_order = 3.0 * PHASE_MEAN_COSINE * flux.dot(to_eye);
-    FLUENCE_GAIN * (phi + first_order).max(0.0) / (4.0 * PI)
-}
+/// The gain on the light volume's transported sunlight
+/// ([`super::light_volume::LightVolume::light_toward`]; `FLUENCE_GAIN` in
+/// WGSL), fitted with the others: 0.766, where exact transport would need
+/// 1 and the octaves took nothing from it. The 80 m cells blur a cloud's
+/// sunlit skin into its shaded inside, where the light is weaker: the
+/// octaves carry the skin's light, and the volume gives some of that back.
+/// (The diffusion it replaced, 2026-12-06, asked for 1.19.)
+pub const FLUENCE_GAIN: f32 = 0.766;
 
 /// Sun light scattered toward the eye per unit scattering coefficient in
 /// cloud of extinction `sigma_t`: single scattering (`phase_dual`
@@ -301,8 +285,9 @@ pub fn diffused_fluence(phi: f32, flux: Vec3, to_eye: Vec3) -> f32 {
 /// power [`MULTIPLE_SUN_POWER`]; and the sunlight diffused through the
 /// layer ([`diffused_sun`]).
 ///
-/// The light volume's term ([`diffused_fluence`]) is added beside this
-/// one (`renderer::diffused_light`). The six gains (the octaves' two,
+/// The light volume's term
+/// ([`super::light_volume::LightVolume::light_toward`]) is added beside
+/// this one (`renderer::diffused_light`). The six gains (the octaves' two,
 /// the two diffused lights', the sky's [`super::renderer::AMBIENT_GAIN`]
 /// and the ground's [`super::renderer::GROUND_LIGHT_GAIN`]) were fitted to Mitsuba
 /// 3's volumetric path tracer (all orders of scattering) on four views: a

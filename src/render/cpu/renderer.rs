@@ -11,7 +11,7 @@ use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::land::{flat_ground_albedo, terrain_albedo};
 use super::light_volume::LightVolume;
 use super::lighting::{
-    ShadowSteps, diffused_fluence, forward_step_factor, integrate_step, shadow_offset,
+    FLUENCE_GAIN, ShadowSteps, forward_step_factor, integrate_step, shadow_offset,
     sun_optical_depth, sun_scattering,
 };
 use super::sea::sea_reflection_change;
@@ -42,6 +42,9 @@ pub struct Quality {
     pub shadow_steps: u32,
     /// Extra multiple-scattering octaves, 0..=3.
     pub octaves: u32,
+    /// Photons the light volume traces per column of its cells
+    /// (`render.light_photons`; 0: no light volume).
+    pub light_photons: u32,
     /// Distance at which the analytic model's aerial perspective has
     /// faded a cloud to 1/e, m.
     pub haze_distance_m: f32,
@@ -203,7 +206,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// ([`ambient_light`]), times this, which stands for that light's own
 /// multiple scattering; fitted with the octaves and the diffused sunlight
 /// ([`super::lighting::sun_scattering`]) and [`GROUND_LIGHT_GAIN`].
-pub const AMBIENT_GAIN: f32 = 4.37;
+pub const AMBIENT_GAIN: f32 = 4.626;
 
 /// The gain on the ground's light in cloud (`GROUND_LIGHT_GAIN` in
 /// WGSL): isotropic scattering of the ground's upward irradiance
@@ -213,7 +216,7 @@ pub const AMBIENT_GAIN: f32 = 4.37;
 /// 2026-12-04 it kept 0.35 at the top under the sky's gain, and the path
 /// tracer measured the change (docs/ground_truth: summed per-pixel error
 /// over its four views 45.3 → 44.8 points, the high sun's 11.2 → 10.7 %).
-pub const GROUND_LIGHT_GAIN: f32 = 3.82;
+pub const GROUND_LIGHT_GAIN: f32 = 0.0;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4`, weighted
@@ -356,16 +359,16 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     }
 }
 
-/// The light volume's diffused sunlight at `p` scattered toward the eye
-/// (`to_eye`, against the ray), per unit scattering coefficient and sun
-/// irradiance ([`diffused_fluence`] of the frame's [`LightVolume`]): 0
-/// without one or without multiple scattering (`octaves` 0).
+/// The light volume's transported sunlight at `p` scattered toward the
+/// eye (`to_eye`, against the ray), per unit scattering coefficient and
+/// sun irradiance ([`LightVolume::light_toward`] times
+/// [`FLUENCE_GAIN`]): 0 without one or without multiple scattering
+/// (`octaves` 0).
 #[inline]
 pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
     match fr.light {
         Some(v) if octaves > 0 => {
-            let (phi, flux) = v.light_at(p, fr.density.map_extent_m);
-            diffused_fluence(phi, flux, to_eye)
+            FLUENCE_GAIN * v.light_toward(p, to_eye, fr.density.map_extent_m)
         }
         _ => 0.0,
     }

@@ -1,14 +1,17 @@
 //! The light volume on the GPU: the twin of
-//! [`crate::render::cpu::light_volume`] (`shaders/light_volume.wgsl`,
-//! `shaders/light_volume_build.wgsl`). Built by compute passes of its
-//! own, submitted before the frame's, whenever P, the sun or the density
-//! changed ([`LightVolumePass::mark_stale`]), not per frame. The last
-//! step writes the fluence and its net flux (`light_flux`) into an rgba
-//! 3D texture (half floats), which the
-//! cloud pass reads with one filtered fetch per lit sample (bind group
-//! 2): reading the buffer's eight corners by hand made the pass 37 %
-//! slower on lavapipe. It exists only with multiple scattering on
-//! (`render.octaves > 0`).
+//! [`crate::render::cpu::light_volume`] and
+//! [`crate::render::cpu::light_transport`] (`shaders/light_volume.wgsl`,
+//! `shaders/light_transport.wgsl`, `shaders/light_volume_build.wgsl`).
+//! Built by compute passes of its own, submitted before the frame's,
+//! whenever P, the sun or the density changed
+//! ([`LightVolumePass::mark_stale`]), not per frame: the cells'
+//! extinction, then the photons in batches (each photon one invocation,
+//! drawing the CPU's random numbers), each batch's tracks added to
+//! fixed-point cells with atomics and folded into float sums, and last
+//! the sums through the phase into three rgba 3D textures (half floats),
+//! which the cloud pass reads with three filtered fetches per lit sample
+//! (bind group 2). It exists only with multiple scattering on
+//! (`render.octaves > 0`) and photons to trace (`render.light_photons`).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -16,7 +19,7 @@ use super::bind::{self, compute_entry};
 use super::context::{GpuContext, GpuError};
 use super::shaders;
 use crate::render::cpu::density::DensityParams;
-use crate::render::cpu::light_volume::{DiffusionGrid, LIGHT_SWEEPS};
+use crate::render::cpu::light_volume::{DiffusionGrid, light_photons};
 
 /// The build's name (its compute pass's label).
 pub const PASS_LIGHT_VOLUME: &str = "light_volume";
@@ -43,9 +46,19 @@ impl From<&DiffusionGrid> for DiffusionGridUniforms {
     }
 }
 
-/// The fluence texture's format: filterable, and writable by a compute
-/// pass without extra features.
-const FLUENCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The planes' format: filterable, and writable by a compute pass
+/// without extra features.
+const PLANE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The fixed-point cells' unit, m of track (`TRACK_UNIT` in WGSL): a
+/// track's length times its harmonic is rounded to it, far below the
+/// cells' 80 m.
+pub const TRACK_UNIT: f32 = 1.0 / 256.0;
+/// Photons per column of cells in one batch: its tracks are folded into
+/// the float sums before the next batch, so no cell's 32-bit sum
+/// overflows (a column's 64 photons lay at most a few kilometres of
+/// track in a cell, 2^31 units are 8,400 km).
+pub const BATCH_PER_COLUMN: u32 = 64;
 
 /// The stride of `light_step`'s entries (the dynamic offsets' alignment).
 const STEP_STRIDE: u64 = 256;
@@ -65,35 +78,61 @@ fn workgroups(n: u32) -> (u32, u32) {
     }
 }
 
+/// The batches of `photons`: each batch's first photon and count.
+fn batches(photons: u32, batch: u32) -> Vec<(u32, u32)> {
+    let batch = batch.max(1);
+    (0..photons.div_ceil(batch))
+        .map(|b| (b * batch, batch.min(photons - b * batch)))
+        .collect()
+}
+
 struct Pipelines {
     cell_extinction: wgpu::ComputePipeline,
-    sun_depth_layer: wgpu::ComputePipeline,
-    relax: wgpu::ComputePipeline,
-    fluence_texture: wgpu::ComputePipeline,
+    trace: wgpu::ComputePipeline,
+    fold_tracks: wgpu::ComputePipeline,
+    sh_planes: wgpu::ComputePipeline,
 }
 
 /// The light volume's buffers, its build and what the cloud pass binds.
 pub struct LightVolumePass {
     pub grid: DiffusionGrid,
+    /// Photons per column of cells (`render.light_photons`).
+    pub per_column: u32,
     build_layout: wgpu::BindGroupLayout,
     build_group: wgpu::BindGroup,
-    /// Group 2 of the cloud pass: the fluence texture and its sampler.
+    /// Group 2 of the cloud pass: the three planes and their sampler.
     pub read_layout: wgpu::BindGroupLayout,
     pub read_group: wgpu::BindGroup,
-    /// The fluence per cell (per unit sun irradiance).
-    pub fluence: wgpu::Buffer,
-    /// What the cloud pass samples: per cell the fluence (r) and the net
-    /// flux (gba), half floats.
-    pub texture: wgpu::Texture,
+    /// One batch's fixed-point tracks, nine a cell.
+    tracks: wgpu::Buffer,
+    /// The tracks of every batch, nine a cell, m.
+    pub sums: wgpu::Buffer,
+    /// What the cloud pass samples: per cell the radiance coefficients
+    /// through the phase (`sh_planes`), half floats.
+    pub planes: [wgpu::Texture; 3],
+    /// The full build's batches: each one's first photon and count.
+    batches: Vec<(u32, u32)>,
+    /// `light_step`'s buffer: one entry per batch, then the progressive
+    /// frame's.
+    steps: wgpu::Buffer,
+    /// `light_fold`: what a fold keeps of the sums and gains of a batch.
+    fold: wgpu::Buffer,
+    /// One batch per frame into a running mean (see
+    /// [`Self::set_progressive`]), else whole builds.
+    progressive: bool,
+    /// Progressive: batches folded since the volume was made, and the
+    /// batches still to trace before it rests.
+    traced: u32,
+    pending: u32,
     pipelines: Option<Pipelines>,
     stale: bool,
     builds: u32,
 }
 
-fn storage(device: &wgpu::Device, label: &str, cells: usize) -> wgpu::Buffer {
+fn storage(device: &wgpu::Device, label: &str, words: usize) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
-        size: (cells.max(1) * 4) as u64,
+        size: (words.max(1) * 4) as u64,
         usage: wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST,
@@ -110,9 +149,15 @@ fn buffer_type(ty: wgpu::BufferBindingType, dynamic: bool) -> wgpu::BindingType 
 }
 
 impl LightVolumePass {
-    /// The volume for the density `d` (its grid, [`DiffusionGrid::new`]),
-    /// stale until its first [`Self::build_if_stale`].
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, d: &DensityParams) -> Self {
+    /// The volume for the density `d` (its grid, [`DiffusionGrid::new`])
+    /// with `per_column` photons a column, stale until its first
+    /// [`Self::build_if_stale`].
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        d: &DensityParams,
+        per_column: u32,
+    ) -> Self {
         let grid = DiffusionGrid::new(d);
         let cells = grid.len();
         let grid_buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -126,47 +171,66 @@ impl LightVolumePass {
             0,
             bytemuck::bytes_of(&DiffusionGridUniforms::from(&grid)),
         );
-        // One entry per layer (`x`: the layer), then one per colour (`y`).
-        let layers = grid.cells.y as u64;
+        let photons = light_photons(&grid, per_column);
+        let columns = grid.cells.x * grid.cells.z;
+        let batches = batches(photons, columns.saturating_mul(BATCH_PER_COLUMN));
+        // One entry per batch: its first photon, its count, the total; the
+        // last entry is the progressive frame's, written per frame.
+        let entries_count = batches.len() as u64 + 1;
         let steps = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light_volume.steps"),
-            size: (layers + 2) * STEP_STRIDE,
+            size: entries_count * STEP_STRIDE,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut entries = vec![0u8; ((layers + 2) * STEP_STRIDE) as usize];
-        for e in 0..layers + 2 {
-            let value: [u32; 4] = if e < layers {
-                [e as u32, 0, 0, 0]
-            } else {
-                [0, (e - layers) as u32, 0, 0]
-            };
-            let at = (e * STEP_STRIDE) as usize;
+        let mut entries = vec![0u8; (entries_count * STEP_STRIDE) as usize];
+        for (e, (first, count)) in batches.iter().enumerate() {
+            let value: [u32; 4] = [*first, *count, photons, 0];
+            let at = e * STEP_STRIDE as usize;
             entries[at..at + 16].copy_from_slice(bytemuck::bytes_of(&value));
         }
         queue.write_buffer(&steps, 0, &entries);
-        let sigma = storage(device, "light_volume.extinction", cells);
-        let tau = storage(device, "light_volume.sun_depth", cells);
-        let fluence = storage(device, "light_volume.fluence", cells);
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("light_volume.fluence_texture"),
-            size: wgpu::Extent3d {
-                width: grid.cells.x,
-                height: grid.cells.y,
-                depth_or_array_layers: grid.cells.z,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: FLUENCE_FORMAT,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
+        let fold = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light_volume.fold"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
-        let texture_view = bind::view(&texture);
+        let sigma = storage(device, "light_volume.extinction", cells);
+        let tracks = storage(device, "light_volume.tracks", 9 * cells);
+        let sums = storage(device, "light_volume.sums", 9 * cells);
+        let plane = |k: usize| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(["light_volume.plane0", "light_volume.plane1", "light_volume.plane2"][k]),
+                size: wgpu::Extent3d {
+                    width: grid.cells.x,
+                    height: grid.cells.y,
+                    depth_or_array_layers: grid.cells.z,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: PLANE_FORMAT,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let planes = [plane(0), plane(1), plane(2)];
+        let views = planes.each_ref().map(bind::view);
         let rw = wgpu::BufferBindingType::Storage { read_only: false };
         let uniform = wgpu::BufferBindingType::Uniform;
+        let plane_entry = |binding: u32| {
+            compute_entry(
+                binding,
+                wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: PLANE_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D3,
+                },
+            )
+        };
         let build_layout = bind::layout(
             device,
             "light_volume.build",
@@ -176,14 +240,10 @@ impl LightVolumePass {
                 compute_entry(2, buffer_type(rw, false)),
                 compute_entry(3, buffer_type(rw, false)),
                 compute_entry(4, buffer_type(rw, false)),
-                compute_entry(
-                    5,
-                    wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: FLUENCE_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D3,
-                    },
-                ),
+                plane_entry(5),
+                plane_entry(6),
+                plane_entry(7),
+                compute_entry(8, buffer_type(uniform, false)),
             ],
         );
         let step_binding = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
@@ -199,9 +259,12 @@ impl LightVolumePass {
                 grid_buffer.as_entire_binding(),
                 step_binding,
                 sigma.as_entire_binding(),
-                tau.as_entire_binding(),
-                fluence.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&texture_view),
+                tracks.as_entire_binding(),
+                sums.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&views[0]),
+                wgpu::BindingResource::TextureView(&views[1]),
+                wgpu::BindingResource::TextureView(&views[2]),
+                fold.as_entire_binding(),
             ],
         );
         // Across the domain the volume repeats; up and down it clamps to
@@ -220,7 +283,9 @@ impl LightVolumePass {
             "light_volume.read",
             &[
                 bind::texture_3d_entry(0, bind::FILTERABLE),
-                bind::sampler_entry(1),
+                bind::texture_3d_entry(1, bind::FILTERABLE),
+                bind::texture_3d_entry(2, bind::FILTERABLE),
+                bind::sampler_entry(3),
             ],
         );
         let read_group = bind::bind(
@@ -228,18 +293,28 @@ impl LightVolumePass {
             "light_volume.read",
             &read_layout,
             &[
-                wgpu::BindingResource::TextureView(&texture_view),
+                wgpu::BindingResource::TextureView(&views[0]),
+                wgpu::BindingResource::TextureView(&views[1]),
+                wgpu::BindingResource::TextureView(&views[2]),
                 wgpu::BindingResource::Sampler(&sampler),
             ],
         );
         Self {
             grid,
+            per_column,
             build_layout,
             build_group,
             read_layout,
             read_group,
-            fluence,
-            texture,
+            tracks,
+            sums,
+            planes,
+            batches,
+            steps,
+            fold,
+            progressive: false,
+            traced: 0,
+            pending: 0,
             pipelines: None,
             stale: true,
             builds: 0,
@@ -250,6 +325,30 @@ impl LightVolumePass {
     /// changed).
     pub fn mark_stale(&mut self) {
         self.stale = true;
+    }
+
+    /// Progressive building, for an interactive frame loop: each frame
+    /// whose volume is stale or still settling traces one batch
+    /// ([`BATCH_PER_COLUMN`] photons a column) into a running mean of the
+    /// last full count's worth (the mean of all batches until there are
+    /// that many), and a change of the clouds or the sun starts a full
+    /// count's worth of batches more, one a frame: the light follows
+    /// slowly changing clouds over that many frames, for a frame's cost
+    /// of one batch. Off (the default): a stale volume is built whole
+    /// before the frame (stills, tests, benchmarks). Switching starts
+    /// afresh.
+    pub fn set_progressive(&mut self, on: bool) {
+        if self.progressive != on {
+            self.progressive = on;
+            self.traced = 0;
+            self.pending = 0;
+            self.stale = true;
+        }
+    }
+
+    /// The batches a full count of photons takes.
+    fn batch_count(&self) -> u32 {
+        self.batches.len() as u32
     }
 
     /// Drops the pipelines (group 0's layout or the constants changed).
@@ -263,10 +362,12 @@ impl LightVolumePass {
         self.pipelines.is_some()
     }
 
-    /// The fluence of every cell read back to the CPU, in the CPU's
-    /// [`DiffusionGrid::index`] order (waits for the GPU).
-    pub fn read_fluence(&self, ctx: &GpuContext) -> Result<Vec<f32>, GpuError> {
-        let size = self.fluence.size();
+    /// Every cell's nine track sums read back to the CPU, as radiance
+    /// coefficients per unit irradiance under the sun `sun_dir` (the
+    /// CPU's [`crate::render::cpu::light_volume::LightVolume::sh`]), in
+    /// the CPU's [`DiffusionGrid::index`] order (waits for the GPU).
+    pub fn read_sh(&self, ctx: &GpuContext, sun_dir: glam::Vec3) -> Result<Vec<[f32; 9]>, GpuError> {
+        let size = self.sums.size();
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light_volume.readback"),
             size,
@@ -278,28 +379,39 @@ impl LightVolumePass {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("light_volume.readback"),
             });
-        encoder.copy_buffer_to_buffer(&self.fluence, 0, &readback, 0, size);
+        encoder.copy_buffer_to_buffer(&self.sums, 0, &readback, 0, size);
         ctx.queue.submit([encoder.finish()]);
         let bytes = ctx.map_read(&readback)?;
-        let mut values: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
-        values.truncate(self.grid.len());
-        Ok(values)
+        let values: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
+        let scale = crate::render::cpu::light_transport::transport_scale(
+            &self.grid,
+            sun_dir,
+            light_photons(&self.grid, self.per_column),
+        );
+        Ok(values
+            .chunks_exact(9)
+            .take(self.grid.len())
+            .map(|c| std::array::from_fn(|k| c[k] * scale))
+            .collect())
     }
 
-    /// The texture the cloud pass samples, read back to the CPU: per cell,
-    /// in the CPU's [`DiffusionGrid::index`] order, the fluence and the
-    /// net flux (waits for the GPU).
-    pub fn read_light(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>, GpuError> {
-        // The texture's texel (i, j, k) is cell (i, j, k); it reads back
-        // k-major (then j, then i), the grid's index is j-major.
-        let texels = ctx.read_rgba16f(&self.texture)?;
-        let (nx, ny) = (self.grid.cells.x as usize, self.grid.cells.y as usize);
-        let mut cells = vec![[0.0; 4]; self.grid.len()];
-        for (t, texel) in texels.into_iter().enumerate() {
-            let (i, j, k) = (t % nx, (t / nx) % ny, t / (nx * ny));
-            cells[self.grid.index(i as i32, j as i32, k as i32)] = texel;
-        }
-        Ok(cells)
+    /// The three planes the cloud pass samples, read back to the CPU: per
+    /// cell, in the CPU's [`DiffusionGrid::index`] order (waits for the
+    /// GPU).
+    pub fn read_planes(&self, ctx: &GpuContext) -> Result<[Vec<[f32; 4]>; 3], GpuError> {
+        let read = |t: &wgpu::Texture| -> Result<Vec<[f32; 4]>, GpuError> {
+            // The texture's texel (i, j, k) is cell (i, j, k); it reads
+            // back k-major (then j, then i), the grid's index is j-major.
+            let texels = ctx.read_rgba16f(t)?;
+            let (nx, ny) = (self.grid.cells.x as usize, self.grid.cells.y as usize);
+            let mut cells = vec![[0.0; 4]; self.grid.len()];
+            for (t, texel) in texels.into_iter().enumerate() {
+                let (i, j, k) = (t % nx, (t / nx) % ny, t / (nx * ny));
+                cells[self.grid.index(i as i32, j as i32, k as i32)] = texel;
+            }
+            Ok(cells)
+        };
+        Ok([read(&self.planes[0])?, read(&self.planes[1])?, read(&self.planes[2])?])
     }
 
     /// Builds since the pass was made.
@@ -325,10 +437,10 @@ impl LightVolumePass {
     }
 
     /// Builds the volume when it is stale: records and submits the
-    /// extinction of every cell, the sun's optical depth layer by layer
-    /// from the band's top, and [`LIGHT_SWEEPS`] red-black sweeps from
-    /// nothing. Reads group 0 (`inputs`, whose frame uniforms must hold
-    /// this frame's sun and density: call after writing them).
+    /// extinction of every cell, the photons batch by batch (each
+    /// batch's fixed-point tracks folded into the sums), and the planes.
+    /// Reads group 0 (`inputs`, whose frame uniforms must hold this
+    /// frame's sun and density: call after writing them).
     pub fn build_if_stale(
         &mut self,
         device: &wgpu::Device,
@@ -337,11 +449,16 @@ impl LightVolumePass {
         group0: &wgpu::BindGroup,
         constants: &[(&str, f64)],
     ) {
+        if self.progressive {
+            self.build_progressively(device, queue, group0_layout, group0, constants);
+            return;
+        }
         if !self.stale {
             return;
         }
         self.stale = false;
         self.builds += 1;
+        queue.write_buffer(&self.fold, 0, bytemuck::cast_slice(&[1.0f32, 1.0, 0.0, 0.0]));
         let p = pipelines(
             &mut self.pipelines,
             &self.build_layout,
@@ -351,36 +468,106 @@ impl LightVolumePass {
         );
         let g = &self.grid;
         let all = workgroups(g.len() as u32);
-        let columns = workgroups(g.cells.x * g.cells.z);
-        let layers = g.cells.y;
+        let words = workgroups(9 * g.len() as u32);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some(PASS_LIGHT_VOLUME),
         });
-        encoder.clear_buffer(&self.fluence, 0, None);
+        encoder.clear_buffer(&self.tracks, 0, None);
+        encoder.clear_buffer(&self.sums, 0, None);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(PASS_LIGHT_VOLUME),
                 timestamp_writes: None,
             });
             pass.set_bind_group(0, group0, &[]);
-            let step = |e: u32| [(e as u64 * STEP_STRIDE) as u32];
+            let step = |e: usize| [(e as u64 * STEP_STRIDE) as u32];
             pass.set_pipeline(&p.cell_extinction);
             pass.set_bind_group(1, &self.build_group, &step(0));
             pass.dispatch_workgroups(all.0, all.1, 1);
-            pass.set_pipeline(&p.sun_depth_layer);
-            for j in (0..layers).rev() {
-                pass.set_bind_group(1, &self.build_group, &step(j));
-                pass.dispatch_workgroups(columns.0, columns.1, 1);
+            for (e, (_, count)) in self.batches.iter().enumerate() {
+                let photons = workgroups(*count);
+                pass.set_pipeline(&p.trace);
+                pass.set_bind_group(1, &self.build_group, &step(e));
+                pass.dispatch_workgroups(photons.0, photons.1, 1);
+                pass.set_pipeline(&p.fold_tracks);
+                pass.dispatch_workgroups(words.0, words.1, 1);
             }
-            pass.set_pipeline(&p.relax);
-            for _ in 0..LIGHT_SWEEPS {
-                for colour in 0..2 {
-                    pass.set_bind_group(1, &self.build_group, &step(layers + colour));
-                    pass.dispatch_workgroups(all.0, all.1, 1);
-                }
-            }
-            pass.set_pipeline(&p.fluence_texture);
+            pass.set_pipeline(&p.sh_planes);
             pass.set_bind_group(1, &self.build_group, &step(0));
+            pass.dispatch_workgroups(all.0, all.1, 1);
+        }
+        queue.submit([encoder.finish()]);
+    }
+}
+
+impl LightVolumePass {
+    /// One progressive frame ([`Self::set_progressive`]): when the volume
+    /// is stale, the cells' extinction anew and a full count of batches to
+    /// come; while batches are to come, one, folded into the running
+    /// mean, and the planes.
+    fn build_progressively(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        group0_layout: &wgpu::BindGroupLayout,
+        group0: &wgpu::BindGroup,
+        constants: &[(&str, f64)],
+    ) {
+        let fresh = self.stale;
+        if fresh {
+            self.stale = false;
+            self.builds += 1;
+            self.pending = self.batch_count();
+        }
+        if self.pending == 0 {
+            return;
+        }
+        let Some(&(_, batch)) = self.batches.first() else {
+            return;
+        };
+        let total = self.batches.iter().map(|b| b.1).sum::<u32>();
+        let window = self.batch_count().max(1);
+        // The mean of the batches so far, then of the last `window`; each
+        // batch's tracks scaled to the full count's.
+        let w = 1.0 / (self.traced + 1).min(window) as f32;
+        let gain = w * total as f32 / batch as f32;
+        queue.write_buffer(&self.fold, 0, bytemuck::cast_slice(&[1.0 - w, gain, 0.0, 0.0]));
+        let first = self.traced.wrapping_mul(batch);
+        let entry: [u32; 4] = [first, batch, total, 0];
+        let last = self.batches.len() as u64 * STEP_STRIDE;
+        queue.write_buffer(&self.steps, last, bytemuck::bytes_of(&entry));
+        self.traced += 1;
+        self.pending -= 1;
+        let p = pipelines(
+            &mut self.pipelines,
+            &self.build_layout,
+            device,
+            group0_layout,
+            constants,
+        );
+        let g = &self.grid;
+        let all = workgroups(g.len() as u32);
+        let words = workgroups(9 * g.len() as u32);
+        let photons = workgroups(batch);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some(PASS_LIGHT_VOLUME),
+        });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(PASS_LIGHT_VOLUME),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, group0, &[]);
+            pass.set_bind_group(1, &self.build_group, &[last as u32]);
+            if fresh {
+                pass.set_pipeline(&p.cell_extinction);
+                pass.dispatch_workgroups(all.0, all.1, 1);
+            }
+            pass.set_pipeline(&p.trace);
+            pass.dispatch_workgroups(photons.0, photons.1, 1);
+            pass.set_pipeline(&p.fold_tracks);
+            pass.dispatch_workgroups(words.0, words.1, 1);
+            pass.set_pipeline(&p.sh_planes);
             pass.dispatch_workgroups(all.0, all.1, 1);
         }
         queue.submit([encoder.finish()]);
@@ -414,9 +601,9 @@ fn pipelines<'a>(
         };
         Pipelines {
             cell_extinction: pipeline("cell_extinction"),
-            sun_depth_layer: pipeline("sun_depth_layer"),
-            relax: pipeline("relax"),
-            fluence_texture: pipeline("fluence_texture"),
+            trace: pipeline("trace"),
+            fold_tracks: pipeline("fold_tracks"),
+            sh_planes: pipeline("sh_planes"),
         }
     })
 }
@@ -427,7 +614,7 @@ mod tests {
 
     #[test]
     fn folded_dispatches_cover_every_invocation() {
-        for n in [1, 63, 64, 65, 4096 * 64, 4096 * 64 + 1, 1_769_472] {
+        for n in [1, 63, 64, 65, 4096 * 64, 4096 * 64 + 1, 1_769_472, 16_257_024] {
             let (x, y) = workgroups(n);
             assert!(x <= 65_535 && y <= 65_535);
             // `light_invocation`: id.x + id.y · ROW · 64 reaches n - 1.
@@ -435,6 +622,20 @@ mod tests {
                 (x * LIGHT_WORKGROUP - 1) + (y - 1) * ROW * LIGHT_WORKGROUP >= n - 1,
                 "{n}"
             );
+        }
+    }
+
+    #[test]
+    fn the_batches_cover_every_photon_once() {
+        for (photons, batch) in [(0, 64), (1, 64), (640, 64), (641, 64), (1000, 1)] {
+            let b = batches(photons, batch);
+            let mut next = 0;
+            for (first, count) in &b {
+                assert_eq!(*first, next);
+                assert!(*count >= 1 && *count <= batch);
+                next += count;
+            }
+            assert_eq!(next, photons);
         }
     }
 }

@@ -143,8 +143,12 @@ pub struct CloudRenderer {
     height: u32,
     inputs: Inputs,
     terrain: Option<TerrainPass>,
-    /// The sunlight diffused through the clouds (multiple scattering on).
+    /// The sunlight scattered more than once through the clouds
+    /// (multiple scattering on).
     light: Option<LightVolumePass>,
+    /// Whether the light volume is built a batch a frame
+    /// ([`Self::set_progressive_light`]).
+    progressive_light: bool,
     clouds: CloudPass,
     tsaa: Option<TsaaPass>,
     composite: CompositePass,
@@ -188,12 +192,15 @@ impl CloudRenderer {
             terrain: terrain.map(|h| TerrainPass::new(device, queue, &inputs, &constants, h, size)),
             light: settings
                 .light_volume()
-                .then(|| LightVolumePass::new(device, queue, &settings.density)),
+                .then(|| {
+                    LightVolumePass::new(device, queue, &settings.density, settings.quality.light_photons)
+                }),
             clouds: CloudPass::new(device, size.0, size.1),
             tsaa: settings
                 .tsaa
                 .map(|t| TsaaPass::new(device, &inputs.layout, &constants, t, size)),
             composite: CompositePass::default(),
+            progressive_light: false,
             inputs,
             device: device.clone(),
             queue: queue.clone(),
@@ -298,8 +305,19 @@ impl CloudRenderer {
         let grid = DiffusionGrid::new(&s.density);
         if !s.light_volume() {
             self.light = None;
-        } else if self.light.as_ref().is_none_or(|l| l.grid != grid) {
-            self.light = Some(LightVolumePass::new(&self.device, &self.queue, &s.density));
+        } else if self
+            .light
+            .as_ref()
+            .is_none_or(|l| l.grid != grid || l.per_column != s.quality.light_photons)
+        {
+            let mut light = LightVolumePass::new(
+                &self.device,
+                &self.queue,
+                &s.density,
+                s.quality.light_photons,
+            );
+            light.set_progressive(self.progressive_light);
+            self.light = Some(light);
             // Group 2's layout is new.
             self.clouds.invalidate();
         } else if let Some(l) = &mut self.light {
@@ -359,6 +377,19 @@ impl CloudRenderer {
     /// debug views.
     pub fn light_volume(&self) -> Option<&LightVolumePass> {
         self.light.as_ref()
+    }
+
+    /// Builds the light volume one batch of photons a frame into a running
+    /// mean ([`LightVolumePass::set_progressive`]), for an interactive
+    /// loop whose clouds change every few frames: a frame costs one
+    /// batch (1/16 of the default count) instead of a whole build, and the
+    /// light settles over 16 frames. Off by default (stills, tests and
+    /// `cumulus bench` build it whole).
+    pub fn set_progressive_light(&mut self, on: bool) {
+        self.progressive_light = on;
+        if let Some(l) = &mut self.light {
+            l.set_progressive(on);
+        }
     }
 
     /// How many times the light volume was built since the renderer was

@@ -28,18 +28,39 @@ pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl"
 /// The land's albedo, plain or fields and woods (after [`CLOUDS`]).
 pub const LAND: &str = include_str!("../../../shaders/land.wgsl");
 
-/// The light volume's grid, read and coefficients (after [`CLOUDS`]; each
-/// module that appends it declares `diffusion_grid` and `light_cells`).
+/// The light volume's grid (after [`CLOUDS`]; each module that appends it
+/// declares `diffusion_grid`).
 pub const LIGHT_VOLUME: &str = include_str!("../../../shaders/light_volume.wgsl");
-/// The light volume's compute entry points (after [`LIGHT_VOLUME`]).
+/// The sunlight's transport (after [`LIGHT_VOLUME`]; reads `light_cells`,
+/// adds to `light_tracks`).
+pub const LIGHT_TRANSPORT: &str = include_str!("../../../shaders/light_transport.wgsl");
+/// The light volume's compute entry points (after [`LIGHT_TRANSPORT`]).
 pub const LIGHT_VOLUME_BUILD: &str = include_str!("../../../shaders/light_volume_build.wgsl");
 
-/// `light_at` where there is no light volume: nothing diffused.
-const NO_LIGHT: &str = "fn light_at(p: vec3f) -> vec4f {\n    return vec4f(0.0);\n}\n";
+/// `light_toward` where there is no light volume: nothing transported.
+const NO_LIGHT: &str = "fn light_toward(p: vec3f, to_eye: vec3f) -> f32 {\n    return 0.0;\n}\n";
 
-/// The cloud pass's bindings of the light volume (group 2: the fluence
-/// texture and its sampler) and its read.
-const LIGHT_READ: &str = "@group(2) @binding(0) var light_fluence: texture_3d<f32>;\n@group(2) @binding(1) var light_sampler: sampler;\n\n// The fluence (x) and net flux (yzw) at p per unit sun irradiance, read\n// where p reads P (the CPU's `LightVolume::light_at`): the texel centres\n// are the cells'.\nfn light_at(p: vec3f) -> vec4f {\n    let q = noise_point(p, warped_lookup(p.x, p.z));\n    let uvw = vec3f(q.x / frame.map.x, (q.y - frame.band.x) / (frame.band.y - frame.band.x), q.z / frame.map.x);\n    return textureSampleLevel(light_fluence, light_sampler, uvw, 0.0);\n}\n";
+/// The cloud pass's bindings of the light volume (group 2: its three
+/// planes and their sampler) and its read.
+const LIGHT_READ: &str = "@group(2) @binding(0) var light_plane0: texture_3d<f32>;
+@group(2) @binding(1) var light_plane1: texture_3d<f32>;
+@group(2) @binding(2) var light_plane2: texture_3d<f32>;
+@group(2) @binding(3) var light_sampler: sampler;
+
+// The transported sunlight at p scattered toward `to_eye`, per unit
+// scattering coefficient and sun irradiance, read where p reads P (the
+// CPU's `LightVolume::light_toward`): the texel centres are the cells'.
+fn light_toward(p: vec3f, to_eye: vec3f) -> f32 {
+    let q = noise_point(p, warped_lookup(p.x, p.z));
+    let uvw = vec3f(q.x / frame.map.x, (q.y - frame.band.x) / (frame.band.y - frame.band.x), q.z / frame.map.x);
+    let a = textureSampleLevel(light_plane0, light_sampler, uvw, 0.0);
+    let b = textureSampleLevel(light_plane1, light_sampler, uvw, 0.0);
+    let c = textureSampleLevel(light_plane2, light_sampler, uvw, 0.0);
+    let y = sh9(to_eye);
+    let s = dot(a, vec4f(y[0], y[1], y[2], y[3])) + dot(b, vec4f(y[4], y[5], y[6], y[7])) + c.x * y[8];
+    return max(s, 0.0);
+}
+";
 
 /// The shared functions with the sky model's: the physical atmosphere's
 /// tables (bindings 7 to 11 of group 0) when `physical`, else the
@@ -157,11 +178,11 @@ pub fn volume_pass() -> String {
     )
 }
 
-/// The light volume's build: its three compute entry points over group 0
+/// The light volume's build: its four compute entry points over group 0
 /// (the density) and group 1 (its buffers).
 pub fn light_volume_build() -> String {
     format!(
-        "{}{NO_LIGHT}\n{LIGHT_VOLUME}\n{LIGHT_VOLUME_BUILD}",
+        "{}{NO_LIGHT}\n{LIGHT_VOLUME}\n{LIGHT_TRANSPORT}\n{LIGHT_VOLUME_BUILD}",
         sky_model(false)
     )
 }
