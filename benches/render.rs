@@ -11,7 +11,7 @@ use cumulus::prepare::Prepared;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::light_transport::trace;
 use cumulus::render::cpu::light_volume::{
-    DiffusionGrid, LIGHT_SEED, cell_extinction, light_photons, sh_planes,
+    LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons, sh_planes,
 };
 use cumulus::render::cpu::renderer::render_linear;
 use cumulus::render::cpu::sky::sun_direction;
@@ -44,7 +44,7 @@ fn render(c: &mut Criterion) {
     let r = &scene.render;
     let frame = prepared.frame(r, r.quality());
     let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
-    let grid = DiffusionGrid::new(&frame.density);
+    let grid = LightVolumeGrid::new(&frame.density);
     c.bench_function("light_volume_cell_extinction", |b| {
         b.iter(|| cell_extinction(&grid, &frame.fields, &frame.density))
     });

@@ -57,7 +57,7 @@ fn scatter(dir: vec3f, state: ptr<function, u32>) -> vec3f {
 
 // Where a photon enters the band's top (in cells) under the sun.
 fn sun_photon(state: ptr<function, u32>) -> vec3f {
-    let cells = vec3f(diffusion_grid.cells.xyz);
+    let cells = vec3f(volume_grid.cells.xyz);
     let x = rng_next(state) * cells.x;
     let z = rng_next(state) * cells.z;
     return vec3f(x, cells.y - 1e-4, z);
@@ -65,8 +65,8 @@ fn sun_photon(state: ptr<function, u32>) -> vec3f {
 
 // The factor from track lengths to radiance per unit sun irradiance.
 fn transport_scale(sun_dir: vec3f, photons: u32) -> f32 {
-    let h = diffusion_grid.cell_m.xyz;
-    let area = h.x * f32(diffusion_grid.cells.x) * h.z * f32(diffusion_grid.cells.z);
+    let h = volume_grid.cell_m.xyz;
+    let area = h.x * f32(volume_grid.cells.x) * h.z * f32(volume_grid.cells.z);
     return sun_dir.y * area / f32(max(photons, 1u)) / (h.x * h.y * h.z);
 }
 
@@ -75,8 +75,8 @@ fn transport_scale(sun_dir: vec3f, photons: u32) -> f32 {
 fn follow(start: vec3f, sun_dir: vec3f, state: ptr<function, u32>) {
     var pos = start;
     var dir = -sun_dir;
-    let h = diffusion_grid.cell_m.xyz;
-    let cells = vec3i(diffusion_grid.cells.xyz);
+    let h = volume_grid.cell_m.xyz;
+    let cells = vec3i(volume_grid.cells.xyz);
     var weight = 1.0;
     var scattered = false;
     var crossed = 0u;

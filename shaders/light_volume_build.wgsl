@@ -8,7 +8,7 @@
 // `light_step` (a dynamic offset into one buffer) says which photons a
 // `trace` dispatch follows: from x, y of them, of z in all.
 
-@group(1) @binding(0) var<uniform> diffusion_grid: DiffusionGrid;
+@group(1) @binding(0) var<uniform> volume_grid: LightVolumeGrid;
 @group(1) @binding(1) var<uniform> light_step: vec4u;
 // The cells' extinction.
 @group(1) @binding(2) var<storage, read_write> light_cells: array<f32>;
@@ -29,7 +29,7 @@ const PHASE_MOMENT_1: f32 = 0.525;
 const PHASE_MOMENT_2: f32 = 0.5025;
 
 fn light_total() -> u32 {
-    return diffusion_grid.cells.w * diffusion_grid.cells.y;
+    return volume_grid.cells.w * volume_grid.cells.y;
 }
 
 // The invocation's cell (or photon): dispatches wider than 65535
@@ -45,8 +45,8 @@ fn cell_extinction(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let c = light_centre(light_cell(idx));
-    let quarter = diffusion_grid.cell_m.xyz * 0.25;
-    let footprint = 0.5 * diffusion_grid.cell_m.x;
+    let quarter = volume_grid.cell_m.xyz * 0.25;
+    let footprint = 0.5 * volume_grid.cell_m.x;
     var sum = 0.0;
     for (var o = 0u; o < 8u; o++) {
         let s = vec3f(

@@ -244,16 +244,14 @@ impl Prepared {
             cloud_map: &self.cloud_map,
         };
         let density = r.density(self.band, self.map_extent_m);
-        let light = (lit
-            && quality.octaves > 0
-            && quality.light_photons > 0
-            && !quality.single_scattering)
-            .then(|| {
-                self.light.get_or_init(|| {
-                    let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
-                    LightVolume::build(&fields, &density, sun, quality.light_photons)
-                })
-            });
+        let light =
+            (lit && quality.octaves > 0 && quality.light_photons > 0 && !quality.single_scattering)
+                .then(|| {
+                    self.light.get_or_init(|| {
+                        let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
+                        LightVolume::build(&fields, &density, sun, quality.light_photons)
+                    })
+                });
         Frame {
             view: r.camera().view(
                 r.width as f32 / r.height.max(1) as f32,

@@ -88,11 +88,19 @@ fn the_gpu_light_volume_is_its_cpu_twin() {
             "{name}: {photons} photons (first frame {first:.1} s on this adapter); GPU against CPU {twin:.3e}, CPU against another seed {noise:.3e}"
         );
         assert!(noise > 0.0);
-        assert!(twin < NOISE_RATIO * noise, "{name}: {twin} vs noise {noise}");
+        assert!(
+            twin < NOISE_RATIO * noise,
+            "{name}: {twin} vs noise {noise}"
+        );
         let n = (cpu.grid.cells.x * cpu.grid.cells.z) as usize;
         let total = cpu.sh.iter().map(|c| c[0] as f64).sum::<f64>();
         for j in 0..cpu.grid.cells.y as usize {
-            let layer = |v: &[[f32; 9]], k: usize| v[j * n..(j + 1) * n].iter().map(|c| c[k] as f64).sum::<f64>();
+            let layer = |v: &[[f32; 9]], k: usize| {
+                v[j * n..(j + 1) * n]
+                    .iter()
+                    .map(|c| c[k] as f64)
+                    .sum::<f64>()
+            };
             for k in [0, 1] {
                 // The fluence and the vertical flux, against the whole
                 // volume's light where a layer holds little.
@@ -138,11 +146,15 @@ fn a_progressive_light_volume_settles_on_the_whole_build() {
     let q = r.quality();
     let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
     let settings = p.gpu_settings(&r, q);
-    let mut whole = p.headless(&ctx, &settings, r.width, r.height).expect("renderer");
+    let mut whole = p
+        .headless(&ctx, &settings, r.width, r.height)
+        .expect("renderer");
     whole.render(&ctx, &r.camera(), 1).expect("frame");
     let pass = whole.renderer.light_volume().expect("light volume");
     let full = pass.read_sh(&ctx, sun).expect("readback");
-    let mut hl = p.headless(&ctx, &settings, r.width, r.height).expect("renderer");
+    let mut hl = p
+        .headless(&ctx, &settings, r.width, r.height)
+        .expect("renderer");
     hl.renderer.set_progressive_light(true);
     hl.render(&ctx, &r.camera(), 2).expect("frames");
     let pass = hl.renderer.light_volume().expect("light volume");

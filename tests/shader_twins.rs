@@ -16,7 +16,7 @@ use cumulus::render::cpu::{
     density, glare, land, light_transport, light_volume, lighting, renderer, sea, sky, sky_luts,
     waves,
 };
-use cumulus::render::gpu::light_volume_pass::{self, DiffusionGridUniforms};
+use cumulus::render::gpu::light_volume_pass::{self, LightVolumeGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
 use cumulus::render::gpu::uniforms::{FrameUniforms, SkyParamsUniforms, SkyViewUniforms};
 
@@ -46,12 +46,12 @@ const GPU_ONLY: &[(&str, &str)] = &[
     ("glare_at", "add_sun_glare per pixel"),
     // Integer wrap of texel indices (rem_euclid on the CPU).
     ("wrap_i", "i64::rem_euclid on the CPU"),
-    // The light volume's grid: DiffusionGrid's methods index, cell, centre.
-    ("light_index", "DiffusionGrid::index"),
-    ("light_cell", "DiffusionGrid::cell"),
-    ("light_centre", "DiffusionGrid::centre"),
-    // Dispatch glue: the CPU iterates over DiffusionGrid::len() cells.
-    ("light_total", "DiffusionGrid::len"),
+    // The light volume's grid: LightVolumeGrid's methods index, cell, centre.
+    ("light_index", "LightVolumeGrid::index"),
+    ("light_cell", "LightVolumeGrid::cell"),
+    ("light_centre", "LightVolumeGrid::centre"),
+    // Dispatch glue: the CPU iterates over LightVolumeGrid::len() cells.
+    ("light_total", "LightVolumeGrid::len"),
     (
         "light_invocation",
         "a folded dispatch's cell (workgroups())",
@@ -412,8 +412,12 @@ fn frame_uniform_members_match_frame_uniforms_offsets() {
     use cumulus::render::cpu::volume::VolumeParams;
     let rust = offsets!(VolumeParams: origin, extent, dims, pick);
     same_layout("VolumeParams", &rust, size_of::<VolumeParams>());
-    let rust = offsets!(DiffusionGridUniforms: cells, cell_m);
-    same_layout("DiffusionGrid", &rust, size_of::<DiffusionGridUniforms>());
+    let rust = offsets!(LightVolumeGridUniforms: cells, cell_m);
+    same_layout(
+        "LightVolumeGrid",
+        &rust,
+        size_of::<LightVolumeGridUniforms>(),
+    );
 }
 
 #[test]

@@ -21,7 +21,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::exposure::luminance;
-use super::light_volume::{DiffusionGrid, LIGHT_SUN_MIN};
+use super::light_volume::{LIGHT_SUN_MIN, LightVolumeGrid};
 use super::renderer::ALBEDO;
 
 /// A photon's random numbers: a 32-bit PCG stream (O'Neill's RXS-M-XS
@@ -134,7 +134,7 @@ pub const ROULETTE_WEIGHT: f32 = 0.1;
 /// the sun `sun_dir`: a grid position (in cells) and its direction
 /// (`sun_photon` in WGSL).
 #[inline]
-pub fn sun_photon(grid: &DiffusionGrid, sun_dir: Vec3, rng: &mut Rng) -> (Vec3, Vec3) {
+pub fn sun_photon(grid: &LightVolumeGrid, sun_dir: Vec3, rng: &mut Rng) -> (Vec3, Vec3) {
     let cells = grid.cells.as_vec3();
     let pos = Vec3::new(rng.next() * cells.x, cells.y - 1e-4, rng.next() * cells.z);
     (pos, -sun_dir)
@@ -145,7 +145,7 @@ pub fn sun_photon(grid: &DiffusionGrid, sun_dir: Vec3, rng: &mut Rng) -> (Vec3, 
 /// carries the power `μ A / N` through the domain's top of area `A`; the
 /// radiance is the track length per volume (`transport_scale`, twin of
 /// the GPU's).
-pub fn transport_scale(grid: &DiffusionGrid, sun_dir: Vec3, photons: u32) -> f32 {
+pub fn transport_scale(grid: &LightVolumeGrid, sun_dir: Vec3, photons: u32) -> f32 {
     sun_dir.y * area(grid) / photons.max(1) as f32 / volume(grid)
 }
 
@@ -155,7 +155,7 @@ pub fn transport_scale(grid: &DiffusionGrid, sun_dir: Vec3, photons: u32) -> f32
 /// the cells' extinction `sigma`. Under a sun below [`LIGHT_SUN_MIN`],
 /// nothing.
 pub fn trace(
-    grid: &DiffusionGrid,
+    grid: &LightVolumeGrid,
     sigma: &[f32],
     sun_dir: Vec3,
     photons: u32,
@@ -173,12 +173,12 @@ pub fn trace(
     sh.iter().map(|c| c.map(|v| v * scale)).collect()
 }
 
-fn area(grid: &DiffusionGrid) -> f32 {
+fn area(grid: &LightVolumeGrid) -> f32 {
     let extent = grid.cell_m * grid.cells.as_vec3();
     extent.x * extent.z
 }
 
-fn volume(grid: &DiffusionGrid) -> f32 {
+fn volume(grid: &LightVolumeGrid) -> f32 {
     grid.cell_m.x * grid.cell_m.y * grid.cell_m.z
 }
 
@@ -191,7 +191,7 @@ fn volume(grid: &DiffusionGrid) -> f32 {
 /// ground-truth study measured it (docs/ground_truth, 2026-12-06), and
 /// the tests check the estimator's scale with it.
 pub fn trace_sky(
-    grid: &DiffusionGrid,
+    grid: &LightVolumeGrid,
     sigma: &[f32],
     radiance: &(dyn Fn(Vec3) -> Vec3 + Sync),
     from_top: bool,
@@ -229,7 +229,7 @@ type Start<'a> = dyn Fn(&mut Rng) -> (Vec3, Vec3, Vec3) + Sync + 'a;
 /// white), and the lengths times [`sh9`] of the direction and the
 /// weight's luminance.
 fn run(
-    grid: &DiffusionGrid,
+    grid: &LightVolumeGrid,
     sigma: &[f32],
     photons: u32,
     seed: u32,
@@ -291,7 +291,7 @@ struct Tracks {
 /// with `scattered_only`; `follow` in WGSL, which adds them to fixed-point
 /// cells).
 fn follow(
-    grid: &DiffusionGrid,
+    grid: &LightVolumeGrid,
     sigma: &[f32],
     start: (Vec3, Vec3, Vec3),
     scattered_only: bool,
@@ -394,8 +394,8 @@ mod tests {
 
     /// A band `layers` cells of 50 m high over a 640 m square that
     /// repeats (so, endless), of uniform extinction `sigma` per metre.
-    fn layer(sigma: f32, layers: u32) -> (DiffusionGrid, Vec<f32>) {
-        let grid = DiffusionGrid {
+    fn layer(sigma: f32, layers: u32) -> (LightVolumeGrid, Vec<f32>) {
+        let grid = LightVolumeGrid {
             cells: UVec3::new(8, layers, 8),
             cell_m: Vec3::new(80.0, 50.0, 80.0),
             bottom_m: 1000.0,
@@ -406,7 +406,7 @@ mod tests {
 
     /// The mean of `values` over layer `j`.
     fn layer_mean<T: Copy + std::iter::Sum<T> + std::ops::Div<f32, Output = T>>(
-        grid: &DiffusionGrid,
+        grid: &LightVolumeGrid,
         values: &[T],
         j: u32,
     ) -> T {
@@ -545,11 +545,16 @@ mod tests {
         // harmonics' order and signs are consistent.
         for (b, w) in [
             (Vec3::Y, Vec3::X),
-            (Vec3::new(0.3, -0.8, 0.52).normalize(), Vec3::new(-0.6, 0.1, 0.79).normalize()),
+            (
+                Vec3::new(0.3, -0.8, 0.52).normalize(),
+                Vec3::new(-0.6, 0.1, 0.79).normalize(),
+            ),
             (Vec3::Z, Vec3::new(0.0, 0.6, 0.8)),
         ] {
             let (yb, yw) = (sh9(b), sh9(w));
-            let got: f32 = (0..9).map(|k| PHASE_MOMENTS[SH_BAND[k]] * yb[k] * yw[k]).sum();
+            let got: f32 = (0..9)
+                .map(|k| PHASE_MOMENTS[SH_BAND[k]] * yb[k] * yw[k])
+                .sum();
             let mu = b.dot(w) as f64;
             let expected: f64 = (0..3)
                 .map(|l| {
@@ -557,7 +562,10 @@ mod tests {
                         / (4.0 * std::f64::consts::PI)
                 })
                 .sum();
-            assert!((got as f64 - expected).abs() < 1e-5, "{b} {w}: {got} vs {expected}");
+            assert!(
+                (got as f64 - expected).abs() < 1e-5,
+                "{b} {w}: {got} vs {expected}"
+            );
         }
     }
 

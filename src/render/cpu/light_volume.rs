@@ -51,14 +51,14 @@ pub const LIGHT_SUN_MIN: f32 = 0.05;
 /// The photons a build of `grid` traces: `per_column` for each column of
 /// cells (`render.light_photons`), so that the light's noise per cell does
 /// not depend on the domain's size (`LightVolumePass` traces as many).
-pub fn light_photons(grid: &DiffusionGrid, per_column: u32) -> u32 {
+pub fn light_photons(grid: &LightVolumeGrid, per_column: u32) -> u32 {
     (grid.cells.x * grid.cells.z).saturating_mul(per_column)
 }
 
 /// The grid: cell counts and sizes, over `[0, extent)²` horizontally and
 /// the band vertically.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DiffusionGrid {
+pub struct LightVolumeGrid {
     pub cells: UVec3,
     /// Cell sides, m.
     pub cell_m: Vec3,
@@ -66,7 +66,7 @@ pub struct DiffusionGrid {
     pub bottom_m: f32,
 }
 
-impl DiffusionGrid {
+impl LightVolumeGrid {
     /// The grid for the density's domain and band.
     pub fn new(d: &DensityParams) -> Self {
         let height = (d.band_top_m - d.band_bottom_m).max(1.0);
@@ -127,7 +127,7 @@ impl DiffusionGrid {
 /// the flux) trilinearly at `p`: wrapping across the domain, clamped to
 /// the band's outer cell centres (`read_cells` in WGSL).
 #[inline]
-pub fn read_cells<T: Cell>(values: &[T], grid: &DiffusionGrid, p: Vec3) -> T {
+pub fn read_cells<T: Cell>(values: &[T], grid: &LightVolumeGrid, p: Vec3) -> T {
     let v = ((p.y - grid.bottom_m) / grid.cell_m.y - 0.5).clamp(0.0, grid.cells.y as f32 - 1.0);
     let j = v.floor();
     let fy = v - j;
@@ -149,7 +149,7 @@ impl Cell for Vec4 {}
 /// The mean extinction of each cell, 1/m: [`density_at`] (with the
 /// detail noise, at the level of detail of half a cell) averaged over the
 /// centres of the cell's eight octants.
-pub fn cell_extinction(grid: &DiffusionGrid, f: &Fields, d: &DensityParams) -> Vec<f32> {
+pub fn cell_extinction(grid: &LightVolumeGrid, f: &Fields, d: &DensityParams) -> Vec<f32> {
     let quarter = grid.cell_m * 0.25;
     let footprint = 0.5 * grid.cell_m.x;
     (0..grid.len())
@@ -174,7 +174,7 @@ pub fn cell_extinction(grid: &DiffusionGrid, f: &Fields, d: &DensityParams) -> V
 /// The sun's height below which the layers' recursion stops: a sun this
 /// Reads one layer's `values` bilinearly at world `(x, z)`, wrapping.
 #[inline]
-pub fn read_layer<T: Cell>(values: &[T], grid: &DiffusionGrid, x: f32, z: f32) -> T {
+pub fn read_layer<T: Cell>(values: &[T], grid: &LightVolumeGrid, x: f32, z: f32) -> T {
     let nx = grid.cells.x as i32;
     let (u, w) = (x / grid.cell_m.x - 0.5, z / grid.cell_m.z - 0.5);
     let (i, k) = (u.floor(), w.floor());
@@ -212,7 +212,7 @@ pub fn sh_planes(sh: &[[f32; 9]]) -> [Vec<Vec4>; 3] {
 /// irradiance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightVolume {
-    pub grid: DiffusionGrid,
+    pub grid: LightVolumeGrid,
     /// The radiance of each cell as [`sh9`] coefficients, per unit
     /// irradiance ([`trace`]).
     pub sh: Vec<[f32; 9]>,
@@ -226,13 +226,13 @@ impl LightVolume {
     /// `sun_dir`: [`cell_extinction`], then `per_column` photons for each
     /// column of cells ([`light_photons`], [`LIGHT_SEED`]).
     pub fn build(f: &Fields, d: &DensityParams, sun_dir: Vec3, per_column: u32) -> Self {
-        let grid = DiffusionGrid::new(d);
+        let grid = LightVolumeGrid::new(d);
         let sigma = cell_extinction(&grid, f, d);
         Self::trace(grid, &sigma, sun_dir, light_photons(&grid, per_column))
     }
 
     /// The volume for the cells' extinction `sigma`, from `photons`.
-    pub fn trace(grid: DiffusionGrid, sigma: &[f32], sun_dir: Vec3, photons: u32) -> Self {
+    pub fn trace(grid: LightVolumeGrid, sigma: &[f32], sun_dir: Vec3, photons: u32) -> Self {
         let sh = trace(&grid, sigma, sun_dir, photons, LIGHT_SEED);
         let planes = sh_planes(&sh);
         Self { grid, sh, planes }

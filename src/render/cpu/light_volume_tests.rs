@@ -7,7 +7,7 @@ use crate::render::cpu::light_transport::{sh_fluence, sh_flux};
 
 /// The cells' extinction of a 1 km ball of cloud (0.03/m) around
 /// `centre`, clear air elsewhere.
-fn cloud_ball(g: &DiffusionGrid, centre: Vec3) -> Vec<f32> {
+fn cloud_ball(g: &LightVolumeGrid, centre: Vec3) -> Vec<f32> {
     (0..g.len())
         .map(|idx| {
             let (i, j, k) = g.cell(idx);
@@ -20,8 +20,8 @@ fn cloud_ball(g: &DiffusionGrid, centre: Vec3) -> Vec<f32> {
         .collect()
 }
 
-fn grid(cells: UVec3, cell_m: f32) -> DiffusionGrid {
-    DiffusionGrid {
+fn grid(cells: UVec3, cell_m: f32) -> LightVolumeGrid {
+    LightVolumeGrid {
         cells,
         cell_m: Vec3::splat(cell_m),
         bottom_m: 1000.0,

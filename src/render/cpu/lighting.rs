@@ -221,7 +221,8 @@ pub const MULTIPLE_GAIN: f32 = 0.254;
 /// The gain on the octaves' isotropic light: light scattered many times
 /// leaves a cloud in every direction, not only in the phase's lobes. It
 /// was 0.91 before the light volume, which now carries most of that
-/// light ([`FLUENCE_GAIN`]).
+/// light ([`FLUENCE_GAIN`]); beside the transported light the fit keeps
+/// 0.508 of it, for the light near the sunlit skin the 80 m cells blur.
 pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
 /// The octaves scale with the sun's height as
 /// `sin(elevation)^MULTIPLE_SUN_POWER`. It was 0.4 from before the light
@@ -237,11 +238,12 @@ pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
 /// sun is 10.6 %, at 0.1 and 0 the low sun 10.2 and 10.4 %).
 pub const MULTIPLE_SUN_POWER: f32 = 0.2;
 /// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
-/// zenith. Held at 0.1 in the last fits (docs/ground_truth, 2026-12-04
-/// and 2026-12-05):
-/// beside the light volume the free fit takes it to 0, for 0.16 points
-/// of summed error, but the renderers that build no light volume (the
-/// spheroids' and the volume's) have only this to fill deep cloud.
+/// zenith. Held at 0.1 in the fits beside the diffusion (docs/ground_truth,
+/// 2026-12-04 and 2026-12-05), for the renderers that build no light
+/// volume (the spheroids' and the volume's), which have only this to
+/// fill deep cloud; beside the transported light the fit with the tops
+/// held gives 0.045 (2026-12-06), and those renderers' deep cloud is that
+/// much darker.
 pub const DIFFUSE_GAIN: f32 = 0.045;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills

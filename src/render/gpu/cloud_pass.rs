@@ -2,7 +2,7 @@
 //! ray, up to the depth (the terrain's or the application's) when there is
 //! one, into the cloud layer (premultiplied radiance, opacity) and, with
 //! TSAA, the cloud distance the reprojection needs. With the light volume
-//! (multiple scattering on) it reads its fluence as bind group 2.
+//! (multiple scattering on) it reads its three planes as bind group 2.
 
 use super::bind::{self, Recorder};
 use super::inputs::Inputs;
@@ -89,7 +89,7 @@ impl CloudPass {
 
     /// Records the pass: clouds in front of `depth` (when given) into the
     /// layer, and the cloud distance into `distance` (TSAA only), lit with
-    /// the light volume's fluence when `light` (its group 2 layout and
+    /// the light volume's planes when `light` (its group 2 layout and
     /// group) is given.
     #[allow(clippy::too_many_arguments)]
     pub fn record(

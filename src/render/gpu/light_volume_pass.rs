@@ -19,26 +19,26 @@ use super::bind::{self, compute_entry};
 use super::context::{GpuContext, GpuError};
 use super::shaders;
 use crate::render::cpu::density::DensityParams;
-use crate::render::cpu::light_volume::{DiffusionGrid, light_photons};
+use crate::render::cpu::light_volume::{LightVolumeGrid, light_photons};
 
 /// The build's name (its compute pass's label).
 pub const PASS_LIGHT_VOLUME: &str = "light_volume";
 
-// Keep in sync with shaders/light_volume.wgsl: DiffusionGrid.
+// Keep in sync with shaders/light_volume.wgsl: LightVolumeGrid.
 /// The grid as WGSL reads it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct DiffusionGridUniforms {
+pub struct LightVolumeGridUniforms {
     /// nx, ny, nz, nx · nz.
     pub cells: [u32; 4],
     /// The cells' sides (m), the band's bottom (m).
     pub cell_m: [f32; 4],
 }
 
-const _: () = assert!(size_of::<DiffusionGridUniforms>() == 32);
+const _: () = assert!(size_of::<LightVolumeGridUniforms>() == 32);
 
-impl From<&DiffusionGrid> for DiffusionGridUniforms {
-    fn from(g: &DiffusionGrid) -> Self {
+impl From<&LightVolumeGrid> for LightVolumeGridUniforms {
+    fn from(g: &LightVolumeGrid) -> Self {
         Self {
             cells: [g.cells.x, g.cells.y, g.cells.z, g.cells.x * g.cells.z],
             cell_m: [g.cell_m.x, g.cell_m.y, g.cell_m.z, g.bottom_m],
@@ -95,7 +95,7 @@ struct Pipelines {
 
 /// The light volume's buffers, its build and what the cloud pass binds.
 pub struct LightVolumePass {
-    pub grid: DiffusionGrid,
+    pub grid: LightVolumeGrid,
     /// Photons per column of cells (`render.light_photons`).
     pub per_column: u32,
     build_layout: wgpu::BindGroupLayout,
@@ -149,7 +149,7 @@ fn buffer_type(ty: wgpu::BufferBindingType, dynamic: bool) -> wgpu::BindingType 
 }
 
 impl LightVolumePass {
-    /// The volume for the density `d` (its grid, [`DiffusionGrid::new`])
+    /// The volume for the density `d` (its grid, [`LightVolumeGrid::new`])
     /// with `per_column` photons a column, stale until its first
     /// [`Self::build_if_stale`].
     pub fn new(
@@ -158,18 +158,18 @@ impl LightVolumePass {
         d: &DensityParams,
         per_column: u32,
     ) -> Self {
-        let grid = DiffusionGrid::new(d);
+        let grid = LightVolumeGrid::new(d);
         let cells = grid.len();
         let grid_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light_volume.grid"),
-            size: size_of::<DiffusionGridUniforms>() as u64,
+            size: size_of::<LightVolumeGridUniforms>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         queue.write_buffer(
             &grid_buffer,
             0,
-            bytemuck::bytes_of(&DiffusionGridUniforms::from(&grid)),
+            bytemuck::bytes_of(&LightVolumeGridUniforms::from(&grid)),
         );
         let photons = light_photons(&grid, per_column);
         let columns = grid.cells.x * grid.cells.z;
@@ -201,7 +201,13 @@ impl LightVolumePass {
         let sums = storage(device, "light_volume.sums", 9 * cells);
         let plane = |k: usize| {
             device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(["light_volume.plane0", "light_volume.plane1", "light_volume.plane2"][k]),
+                label: Some(
+                    [
+                        "light_volume.plane0",
+                        "light_volume.plane1",
+                        "light_volume.plane2",
+                    ][k],
+                ),
                 size: wgpu::Extent3d {
                     width: grid.cells.x,
                     height: grid.cells.y,
@@ -365,8 +371,12 @@ impl LightVolumePass {
     /// Every cell's nine track sums read back to the CPU, as radiance
     /// coefficients per unit irradiance under the sun `sun_dir` (the
     /// CPU's [`crate::render::cpu::light_volume::LightVolume::sh`]), in
-    /// the CPU's [`DiffusionGrid::index`] order (waits for the GPU).
-    pub fn read_sh(&self, ctx: &GpuContext, sun_dir: glam::Vec3) -> Result<Vec<[f32; 9]>, GpuError> {
+    /// the CPU's [`LightVolumeGrid::index`] order (waits for the GPU).
+    pub fn read_sh(
+        &self,
+        ctx: &GpuContext,
+        sun_dir: glam::Vec3,
+    ) -> Result<Vec<[f32; 9]>, GpuError> {
         let size = self.sums.size();
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light_volume.readback"),
@@ -396,7 +406,7 @@ impl LightVolumePass {
     }
 
     /// The three planes the cloud pass samples, read back to the CPU: per
-    /// cell, in the CPU's [`DiffusionGrid::index`] order (waits for the
+    /// cell, in the CPU's [`LightVolumeGrid::index`] order (waits for the
     /// GPU).
     pub fn read_planes(&self, ctx: &GpuContext) -> Result<[Vec<[f32; 4]>; 3], GpuError> {
         let read = |t: &wgpu::Texture| -> Result<Vec<[f32; 4]>, GpuError> {
@@ -411,7 +421,11 @@ impl LightVolumePass {
             }
             Ok(cells)
         };
-        Ok([read(&self.planes[0])?, read(&self.planes[1])?, read(&self.planes[2])?])
+        Ok([
+            read(&self.planes[0])?,
+            read(&self.planes[1])?,
+            read(&self.planes[2])?,
+        ])
     }
 
     /// Builds since the pass was made.
@@ -458,7 +472,11 @@ impl LightVolumePass {
         }
         self.stale = false;
         self.builds += 1;
-        queue.write_buffer(&self.fold, 0, bytemuck::cast_slice(&[1.0f32, 1.0, 0.0, 0.0]));
+        queue.write_buffer(
+            &self.fold,
+            0,
+            bytemuck::cast_slice(&[1.0f32, 1.0, 0.0, 0.0]),
+        );
         let p = pipelines(
             &mut self.pipelines,
             &self.build_layout,
@@ -531,7 +549,11 @@ impl LightVolumePass {
         // batch's tracks scaled to the full count's.
         let w = 1.0 / (self.traced + 1).min(window) as f32;
         let gain = w * total as f32 / batch as f32;
-        queue.write_buffer(&self.fold, 0, bytemuck::cast_slice(&[1.0 - w, gain, 0.0, 0.0]));
+        queue.write_buffer(
+            &self.fold,
+            0,
+            bytemuck::cast_slice(&[1.0 - w, gain, 0.0, 0.0]),
+        );
         let first = self.traced.wrapping_mul(batch);
         let entry: [u32; 4] = [first, batch, total, 0];
         let last = self.batches.len() as u64 * STEP_STRIDE;
@@ -614,7 +636,16 @@ mod tests {
 
     #[test]
     fn folded_dispatches_cover_every_invocation() {
-        for n in [1, 63, 64, 65, 4096 * 64, 4096 * 64 + 1, 1_769_472, 16_257_024] {
+        for n in [
+            1,
+            63,
+            64,
+            65,
+            4096 * 64,
+            4096 * 64 + 1,
+            1_769_472,
+            16_257_024,
+        ] {
             let (x, y) = workgroups(n);
             assert!(x <= 65_535 && y <= 65_535);
             // `light_invocation`: id.x + id.y · ROW · 64 reaches n - 1.

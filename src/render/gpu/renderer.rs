@@ -50,7 +50,7 @@ use super::uniforms::{FrameInputs, FrameUniforms};
 use super::{bind, bind::Recorder};
 use crate::render::camera::{ToView, View};
 use crate::render::cloud_map::CloudMap;
-use crate::render::cpu::light_volume::DiffusionGrid;
+use crate::render::cpu::light_volume::LightVolumeGrid;
 use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;
@@ -190,11 +190,14 @@ impl CloudRenderer {
         let size = (0, 0);
         Self {
             terrain: terrain.map(|h| TerrainPass::new(device, queue, &inputs, &constants, h, size)),
-            light: settings
-                .light_volume()
-                .then(|| {
-                    LightVolumePass::new(device, queue, &settings.density, settings.quality.light_photons)
-                }),
+            light: settings.light_volume().then(|| {
+                LightVolumePass::new(
+                    device,
+                    queue,
+                    &settings.density,
+                    settings.quality.light_photons,
+                )
+            }),
             clouds: CloudPass::new(device, size.0, size.1),
             tsaa: settings
                 .tsaa
@@ -302,7 +305,7 @@ impl CloudRenderer {
         if old.light_volume() != s.light_volume() {
             self.clouds.invalidate();
         }
-        let grid = DiffusionGrid::new(&s.density);
+        let grid = LightVolumeGrid::new(&s.density);
         if !s.light_volume() {
             self.light = None;
         } else if self

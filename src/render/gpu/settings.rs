@@ -48,7 +48,9 @@ impl GpuSettings {
     /// Whether the light volume exists: with multiple scattering on
     /// (`octaves > 0`), as on the CPU ([`crate::prepare::Prepared::frame`]).
     pub fn light_volume(&self) -> bool {
-        self.quality.octaves > 0 && self.quality.light_photons > 0 && !self.quality.single_scattering
+        self.quality.octaves > 0
+            && self.quality.light_photons > 0
+            && !self.quality.single_scattering
     }
 
     /// The physical sky's atmosphere (`None`: the analytic sky).

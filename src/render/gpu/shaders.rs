@@ -29,7 +29,7 @@ pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl"
 pub const LAND: &str = include_str!("../../../shaders/land.wgsl");
 
 /// The light volume's grid (after [`CLOUDS`]; each module that appends it
-/// declares `diffusion_grid`).
+/// declares `volume_grid`).
 pub const LIGHT_VOLUME: &str = include_str!("../../../shaders/light_volume.wgsl");
 /// The sunlight's transport (after [`LIGHT_VOLUME`]; reads `light_cells`,
 /// adds to `light_tracks`).
