@@ -26,6 +26,9 @@ override SEA_WIND_TOWARD_DEG: f32 = 90.0;
 // Fade clouds and ground with distance (`[render.atmosphere]
 // aerial_perspective`), read by the sky file's `aerial`.
 override AERIAL_PERSPECTIVE: bool = true;
+// The cloud pass reads the light volume: the light's gains fitted beside
+// it (`light_gains`), else those of the renderers without one.
+override LIGHT_VOLUME: bool = false;
 
 const PI: f32 = 3.14159265358979;
 const BASE_RAMP: f32 = 0.04;
@@ -77,13 +80,18 @@ const OCTAVE_SCATTERING: f32 = 0.5;
 const OCTAVE_EXTINCTION: f32 = 0.5;
 const OCTAVE_ECCENTRICITY: f32 = 0.9;
 const MULTIPLE_GAIN: f32 = 0.254;
+const MULTIPLE_GAIN_ALONE: f32 = 0.53;
 const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
+const MULTIPLE_ISOTROPIC_GAIN_ALONE: f32 = 0.46;
 const MULTIPLE_SUN_POWER: f32 = 0.2;
 const DIFFUSE_GAIN: f32 = 0.045;
+const DIFFUSE_GAIN_ALONE: f32 = 0.1;
 const DIFFUSE_DEPTH_M: f32 = 100.0;
 const FLUENCE_GAIN: f32 = 0.766;
 const AMBIENT_GAIN: f32 = 4.626;
+const AMBIENT_GAIN_ALONE: f32 = 4.37;
 const GROUND_LIGHT_GAIN: f32 = 0.0;
+const GROUND_LIGHT_GAIN_ALONE: f32 = 3.82;
 // The share of the sun's horizontal irradiance a whole sky of cloud sends
 // down onto the land (the CPU's sky.rs).
 const GROUND_CLOUD_LIGHT: f32 = 0.53;
@@ -483,10 +491,30 @@ fn shadow_step_count(steps: u32, length: f32, forward: f32) -> u32 {
     return u32(ceil(f32(steps) * min(along * forward, SHADOW_STEP_FACTOR_MAX)));
 }
 
+// The light's six fitted gains (the CPU's `LightGains`).
+struct LightGains {
+    multiple: f32,
+    multiple_isotropic: f32,
+    diffuse: f32,
+    fluence: f32,
+    ambient: f32,
+    ground: f32,
+}
+
+// The gains fitted beside the light volume when the pass reads one
+// (LIGHT_VOLUME), else the renderers' without one (the CPU's
+// `light_gains`).
+fn light_gains() -> LightGains {
+    if LIGHT_VOLUME {
+        return LightGains(MULTIPLE_GAIN, MULTIPLE_ISOTROPIC_GAIN, DIFFUSE_GAIN, FLUENCE_GAIN, AMBIENT_GAIN, GROUND_LIGHT_GAIN);
+    }
+    return LightGains(MULTIPLE_GAIN_ALONE, MULTIPLE_ISOTROPIC_GAIN_ALONE, DIFFUSE_GAIN_ALONE, 0.0, AMBIENT_GAIN_ALONE, GROUND_LIGHT_GAIN_ALONE);
+}
+
 // The sunlight diffused through the cloud layer, per unit scattering
 // coefficient, in cloud of extinction `sigma_t` (the CPU's `diffused_sun`).
 fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
-    return DIFFUSE_GAIN * max(mu_sun, 0.0) * (1.0 - exp(-sigma_t * DIFFUSE_DEPTH_M)) / (4.0 * PI);
+    return light_gains().diffuse * max(mu_sun, 0.0) * (1.0 - exp(-sigma_t * DIFFUSE_DEPTH_M)) / (4.0 * PI);
 }
 
 // The real spherical harmonics to l = 2 at unit `d` (the CPU's `sh9`):
@@ -517,7 +545,8 @@ fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32, sigma_t: f32) -> f3
         return sum;
     }
     let height = pow(max(mu_sun, 0.0), MULTIPLE_SUN_POWER);
-    let isotropic = MULTIPLE_ISOTROPIC_GAIN / (4.0 * PI);
+    let gains = light_gains();
+    let isotropic = gains.multiple_isotropic / (4.0 * PI);
     var a = 1.0;
     var b = 1.0;
     var c = 1.0;
@@ -525,7 +554,7 @@ fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32, sigma_t: f32) -> f3
         a *= OCTAVE_SCATTERING;
         b *= OCTAVE_EXTINCTION;
         c *= OCTAVE_ECCENTRICITY;
-        let phase = MULTIPLE_GAIN * phase_dual(cos_theta, c) + isotropic;
+        let phase = gains.multiple * phase_dual(cos_theta, c) + isotropic;
         sum += height * a * phase * exp(-b * tau_sun);
     }
     return sum + diffused_sun(mu_sun, sigma_t);
@@ -535,7 +564,8 @@ fn sun_scattering(tau_sun: f32, cos_theta: f32, mu_sun: f32, sigma_t: f32) -> f3
 // (the CPU's `ambient_light`): the sky's from 0.35 at the band's bottom
 // to all at its top, the ground's from all at the bottom to none at the top.
 fn ambient_light(sky_top: vec3f, ground: vec3f, eta: f32) -> vec3f {
-    return sky_top * ((0.35 + 0.65 * eta) * AMBIENT_GAIN) + ground * ((1.0 - eta) * GROUND_LIGHT_GAIN);
+    let gains = light_gains();
+    return sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground);
 }
 
 fn integrate_step(s: vec3f, sigma_t: f32, dt: f32) -> vec3f {

@@ -163,6 +163,17 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ),
         ("MULTIPLE_SUN_POWER", lighting::MULTIPLE_SUN_POWER as f64),
         ("DIFFUSE_GAIN", lighting::DIFFUSE_GAIN as f64),
+        ("DIFFUSE_GAIN_ALONE", lighting::DIFFUSE_GAIN_ALONE as f64),
+        ("MULTIPLE_GAIN_ALONE", lighting::MULTIPLE_GAIN_ALONE as f64),
+        (
+            "MULTIPLE_ISOTROPIC_GAIN_ALONE",
+            lighting::MULTIPLE_ISOTROPIC_GAIN_ALONE as f64,
+        ),
+        ("AMBIENT_GAIN_ALONE", renderer::AMBIENT_GAIN_ALONE as f64),
+        (
+            "GROUND_LIGHT_GAIN_ALONE",
+            renderer::GROUND_LIGHT_GAIN_ALONE as f64,
+        ),
         ("DIFFUSE_DEPTH_M", lighting::DIFFUSE_DEPTH_M as f64),
         ("AMBIENT_GAIN", renderer::AMBIENT_GAIN as f64),
         ("GROUND_LIGHT_GAIN", renderer::GROUND_LIGHT_GAIN as f64),

@@ -7,6 +7,9 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::density::{DensityParams, Fields, density_at, height_fraction, smoothstep};
+use super::renderer::{
+    AMBIENT_GAIN, AMBIENT_GAIN_ALONE, GROUND_LIGHT_GAIN, GROUND_LIGHT_GAIN_ALONE,
+};
 use crate::render::sampling::GOLDEN;
 
 /// Henyey-Greenstein phase function, 1/sr; integrates to 1 over the sphere.
@@ -218,12 +221,16 @@ pub const OCTAVE_ECCENTRICITY: f32 = 0.9;
 /// [`FLUENCE_GAIN`] and the sky's and the ground's gains are;
 /// docs/ground_truth).
 pub const MULTIPLE_GAIN: f32 = 0.254;
+/// [`MULTIPLE_GAIN`] where no light volume is built ([`LightGains::ALONE`]).
+pub const MULTIPLE_GAIN_ALONE: f32 = 0.53;
 /// The gain on the octaves' isotropic light: light scattered many times
 /// leaves a cloud in every direction, not only in the phase's lobes. It
 /// was 0.91 before the light volume, which now carries most of that
 /// light ([`FLUENCE_GAIN`]); beside the transported light the fit keeps
 /// 0.508 of it, for the light near the sunlit skin the 80 m cells blur.
 pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
+/// [`MULTIPLE_ISOTROPIC_GAIN`] where no light volume is built.
+pub const MULTIPLE_ISOTROPIC_GAIN_ALONE: f32 = 0.46;
 /// The octaves scale with the sun's height as
 /// `sin(elevation)^MULTIPLE_SUN_POWER`. It was 0.4 from before the light
 /// volume, when the octaves also stood for the light a whole layer takes
@@ -243,8 +250,10 @@ pub const MULTIPLE_SUN_POWER: f32 = 0.2;
 /// volume (the spheroids' and the volume's), which have only this to
 /// fill deep cloud; beside the transported light the fit with the tops
 /// held gives 0.045 (2026-12-06), and those renderers' deep cloud is that
-/// much darker.
+/// much darker: they take [`DIFFUSE_GAIN_ALONE`] ([`LightGains`]).
 pub const DIFFUSE_GAIN: f32 = 0.045;
+/// [`DIFFUSE_GAIN`] where no light volume is built.
+pub const DIFFUSE_GAIN_ALONE: f32 = 0.1;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
 /// cloud, not the thin haze and wisps between clouds, which have little
@@ -253,7 +262,8 @@ pub const DIFFUSE_DEPTH_M: f32 = 100.0;
 
 /// The sunlight diffused through the cloud layer, per unit scattering
 /// coefficient and per unit sun irradiance, in cloud of extinction
-/// `sigma_t`, under a sun of height `mu_sun` (`sin` of its elevation).
+/// `sigma_t`, under a sun of height `mu_sun` (`sin` of its elevation),
+/// times the `gains`' `diffuse`.
 ///
 /// Sunlight that enters a deep layer of cloud is scattered hundreds of
 /// times and spreads through it, in every direction: what the layer
@@ -263,8 +273,8 @@ pub const DIFFUSE_DEPTH_M: f32 = 100.0;
 /// deep cloud rises with the depth the camera sees, and a term of the
 /// shadow ray alone, as the octaves are, falls with it (docs/ground_truth).
 #[inline]
-pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
-    DIFFUSE_GAIN * mu_sun.max(0.0) * (1.0 - (-sigma_t * DIFFUSE_DEPTH_M).exp()) / (4.0 * PI)
+pub fn diffused_sun(mu_sun: f32, sigma_t: f32, gains: &LightGains) -> f32 {
+    gains.diffuse * mu_sun.max(0.0) * (1.0 - (-sigma_t * DIFFUSE_DEPTH_M).exp()) / (4.0 * PI)
 }
 
 /// The gain on the light volume's transported sunlight
@@ -275,6 +285,59 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32) -> f32 {
 /// octaves carry the skin's light, and the volume gives some of that back.
 /// (The diffusion it replaced, 2026-12-06, asked for 1.19.)
 pub const FLUENCE_GAIN: f32 = 0.766;
+
+/// The six fitted gains of the light (`light_gains` in WGSL, which picks
+/// them by its `LIGHT_VOLUME` override): the octaves' forward and
+/// isotropic parts, the diffused sunlight, the transported light, the
+/// sky's and the ground's light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightGains {
+    pub multiple: f32,
+    pub multiple_isotropic: f32,
+    pub diffuse: f32,
+    pub fluence: f32,
+    pub ambient: f32,
+    pub ground: f32,
+}
+
+impl LightGains {
+    /// Beside the transported light volume (fitted to the path tracer
+    /// with it, 2026-12-06): the cloud map's renderer with multiple
+    /// scattering on.
+    pub const TRANSPORT: Self = Self {
+        multiple: MULTIPLE_GAIN,
+        multiple_isotropic: MULTIPLE_ISOTROPIC_GAIN,
+        diffuse: DIFFUSE_GAIN,
+        fluence: FLUENCE_GAIN,
+        ambient: AMBIENT_GAIN,
+        ground: GROUND_LIGHT_GAIN,
+    };
+    /// Where no light volume is built (the spheroids' and the volumes'
+    /// renderers; the cloud map's with `render.light_photons = 0`): the
+    /// gains fitted beside the diffusion (2026-12-05), under which these
+    /// renderers were drawn until the transport. Beside the transport the
+    /// fit gives the ground's light nothing and the octaves half as much,
+    /// which leaves a renderer without the volume's light navy in its
+    /// shade.
+    pub const ALONE: Self = Self {
+        multiple: MULTIPLE_GAIN_ALONE,
+        multiple_isotropic: MULTIPLE_ISOTROPIC_GAIN_ALONE,
+        diffuse: DIFFUSE_GAIN_ALONE,
+        fluence: 0.0,
+        ambient: AMBIENT_GAIN_ALONE,
+        ground: GROUND_LIGHT_GAIN_ALONE,
+    };
+}
+
+/// The gains for a renderer with a light volume (`volume`) or without.
+#[inline]
+pub fn light_gains(volume: bool) -> LightGains {
+    if volume {
+        LightGains::TRANSPORT
+    } else {
+        LightGains::ALONE
+    }
+}
 
 /// Sun light scattered toward the eye per unit scattering coefficient in
 /// cloud of extinction `sigma_t`: single scattering (`phase_dual`
@@ -304,22 +367,23 @@ pub fn sun_scattering(
     mu_sun: f32,
     sigma_t: f32,
     octaves: u32,
+    gains: &LightGains,
 ) -> f32 {
     let mut sum = phase_dual(cos_theta, 1.0) * (-tau_sun).exp();
     if octaves == 0 {
         return sum;
     }
     let height = mu_sun.max(0.0).powf(MULTIPLE_SUN_POWER);
-    let isotropic = MULTIPLE_ISOTROPIC_GAIN / (4.0 * PI);
+    let isotropic = gains.multiple_isotropic / (4.0 * PI);
     let (mut a, mut b, mut c) = (1.0, 1.0, 1.0);
     for _ in 0..octaves {
         a *= OCTAVE_SCATTERING;
         b *= OCTAVE_EXTINCTION;
         c *= OCTAVE_ECCENTRICITY;
-        let phase = MULTIPLE_GAIN * phase_dual(cos_theta, c) + isotropic;
+        let phase = gains.multiple * phase_dual(cos_theta, c) + isotropic;
         sum += height * a * phase * (-b * tau_sun).exp();
     }
-    sum + diffused_sun(mu_sun, sigma_t)
+    sum + diffused_sun(mu_sun, sigma_t, gains)
 }
 
 /// Energy-conserving integral of in-scattered light `s` over a step of
@@ -336,6 +400,8 @@ pub fn integrate_step(s: Vec3, sigma_t: f32, dt: f32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const G: LightGains = LightGains::TRANSPORT;
 
     #[test]
     fn hg_phase_integrates_to_one() {
@@ -358,7 +424,7 @@ mod tests {
         // still holds the light diffused through the layer: the octaves
         // are gone (e^{-0.125 * 200}), the diffused light is not.
         let (cos, mu, sigma) = (0.3, 0.8, 0.03);
-        let deep = sun_scattering(200.0, cos, mu, sigma, 3);
+        let deep = sun_scattering(200.0, cos, mu, sigma, 3, &G);
         let expected = DIFFUSE_GAIN * mu / (4.0 * PI);
         assert!(
             deep > 0.9 * expected && deep < 1.01 * expected,
@@ -366,14 +432,14 @@ mod tests {
         );
         // It scales with the sun's flux through the layer, sin(elevation),
         // and is the same in every direction.
-        let low = sun_scattering(200.0, cos, 0.2, sigma, 3);
+        let low = sun_scattering(200.0, cos, 0.2, sigma, 3, &G);
         assert!((low / deep - 0.25).abs() < 0.02, "{low} / {deep}");
-        assert_eq!(deep, sun_scattering(200.0, -0.9, mu, sigma, 3));
+        assert_eq!(deep, sun_scattering(200.0, -0.9, mu, sigma, 3, &G));
         // Thin haze carries little of it; a sun below the horizon none.
-        assert!(diffused_sun(mu, 1e-4) < 0.02 * diffused_sun(mu, sigma));
-        assert_eq!(diffused_sun(-0.1, sigma), 0.0);
+        assert!(diffused_sun(mu, 1e-4, &G) < 0.02 * diffused_sun(mu, sigma, &G));
+        assert_eq!(diffused_sun(-0.1, sigma, &G), 0.0);
         // No octaves: single scattering alone, nothing diffused.
-        let single = sun_scattering(2.0, cos, mu, sigma, 0);
+        let single = sun_scattering(2.0, cos, mu, sigma, 0, &G);
         assert_eq!(single, phase_dual(cos, 1.0) * (-2.0_f32).exp());
     }
 
@@ -383,15 +449,16 @@ mod tests {
         // (cos 0) at least the isotropic part's share, not only what the
         // forward lobes send there.
         let (mu, sigma) = (1.0, 0.03);
-        let side = sun_scattering(0.0, 0.0, mu, sigma, 3) - sun_scattering(0.0, 0.0, mu, sigma, 0);
+        let side =
+            sun_scattering(0.0, 0.0, mu, sigma, 3, &G) - sun_scattering(0.0, 0.0, mu, sigma, 0, &G);
         let iso: f32 = (1..=3).map(|i| OCTAVE_SCATTERING.powi(i)).sum::<f32>()
             * MULTIPLE_ISOTROPIC_GAIN
             / (4.0 * PI);
-        assert!(side > iso + diffused_sun(mu, sigma), "{side} vs {iso}");
+        assert!(side > iso + diffused_sun(mu, sigma, &G), "{side} vs {iso}");
         // Toward the sun the forward lobes add far more (an isotropic
         // light alone would add the same).
-        let forward =
-            sun_scattering(0.0, 0.99, mu, sigma, 3) - sun_scattering(0.0, 0.99, mu, sigma, 0);
+        let forward = sun_scattering(0.0, 0.99, mu, sigma, 3, &G)
+            - sun_scattering(0.0, 0.99, mu, sigma, 0, &G);
         assert!(forward > 2.0 * side, "{forward} vs {side}");
     }
 

@@ -11,8 +11,8 @@ use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::land::{flat_ground_albedo, terrain_albedo};
 use super::light_volume::LightVolume;
 use super::lighting::{
-    FLUENCE_GAIN, ShadowSteps, forward_step_factor, integrate_step, shadow_offset,
-    sun_optical_depth, sun_scattering,
+    FLUENCE_GAIN, LightGains, ShadowSteps, forward_step_factor, integrate_step, light_gains,
+    shadow_offset, sun_optical_depth, sun_scattering,
 };
 use super::sea::sea_reflection_change;
 use super::sky::{
@@ -208,6 +208,9 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// sunlight ([`super::lighting::sun_scattering`], [`FLUENCE_GAIN`]) and
 /// [`GROUND_LIGHT_GAIN`] (4.37 beside the diffusion).
 pub const AMBIENT_GAIN: f32 = 4.626;
+/// [`AMBIENT_GAIN`] where no light volume is built
+/// ([`super::lighting::LightGains::ALONE`]).
+pub const AMBIENT_GAIN_ALONE: f32 = 4.37;
 
 /// The gain on the ground's light in cloud (`GROUND_LIGHT_GAIN` in
 /// WGSL): isotropic scattering of the ground's upward irradiance
@@ -221,15 +224,18 @@ pub const AMBIENT_GAIN: f32 = 4.626;
 /// is kept for a refit against references with a ground, but at 0 the
 /// renderers add nothing from it.
 pub const GROUND_LIGHT_GAIN: f32 = 0.0;
+/// [`GROUND_LIGHT_GAIN`] where no light volume is built.
+pub const GROUND_LIGHT_GAIN_ALONE: f32 = 3.82;
 
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4`, weighted
-/// from 0.35 at the bottom to 1 at the top, times [`AMBIENT_GAIN`], and the
-/// ground's `ground / 4`, weighted from 1 at the bottom to 0 at the top,
-/// times [`GROUND_LIGHT_GAIN`].
+/// from 0.35 at the bottom to 1 at the top, times the `gains`' `ambient`
+/// ([`AMBIENT_GAIN`] beside the light volume), and the ground's `ground /
+/// 4`, weighted from 1 at the bottom to 0 at the top, times their
+/// `ground` ([`GROUND_LIGHT_GAIN`]).
 #[inline]
-pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32) -> Vec3 {
-    sky_top * ((0.35 + 0.65 * eta) * AMBIENT_GAIN) + ground * ((1.0 - eta) * GROUND_LIGHT_GAIN)
+pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32, gains: &LightGains) -> Vec3 {
+    sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground)
 }
 
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
@@ -284,6 +290,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     // isotropically (1/4π).
     let sky_top = sky_ambient(sky, sun_dir) * 0.25;
     let ground = ground_up(sky, sun_dir, q.sea_wind_mps.is_some()) * 0.25;
+    let gains = light_gains(fr.light.is_some());
     let cos = dir.dot(sun_dir);
     let shadow_ray = ShadowSteps {
         steps: q.shadow_steps,
@@ -327,10 +334,10 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             let (ambient, octaves) = if q.single_scattering {
                 (Vec3::ZERO, 0)
             } else {
-                (ambient_light(sky_top, ground, eta), q.octaves)
+                (ambient_light(sky_top, ground, eta, &gains), q.octaves)
             };
             let scatter = sun
-                * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, octaves)
+                * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, octaves, &gains)
                     + diffused_light(p, -dir, octaves, fr))
                 + ambient;
             let s = scatter * (sigma_t * ALBEDO);

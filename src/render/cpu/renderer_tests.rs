@@ -32,15 +32,20 @@ fn march_steps_span_the_segment_and_grow_with_distance() {
 #[test]
 fn ground_light_reaches_the_base_not_the_top() {
     let (sky, ground) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0));
-    let top = ambient_light(sky, ground, 1.0);
-    let base = ambient_light(sky, ground, 0.0);
+    // Without a light volume (the gains with a ground's light).
+    let g = &crate::render::cpu::lighting::LightGains::ALONE;
+    let top = ambient_light(sky, ground, 1.0, g);
+    let base = ambient_light(sky, ground, 0.0, g);
     assert_eq!(top.x, 0.0, "ground light at the top: {top}");
-    assert!((base.x - GROUND_LIGHT_GAIN).abs() < 1e-6, "{base}");
-    assert!((top.z - AMBIENT_GAIN).abs() < 1e-6, "{top}");
-    assert!((base.z - 0.35 * AMBIENT_GAIN).abs() < 1e-6, "{base}");
+    assert!((base.x - GROUND_LIGHT_GAIN_ALONE).abs() < 1e-6, "{base}");
+    assert!((top.z - AMBIENT_GAIN_ALONE).abs() < 1e-6, "{top}");
+    assert!((base.z - 0.35 * AMBIENT_GAIN_ALONE).abs() < 1e-6, "{base}");
     // Halfway up, half the ground's light.
-    let mid = ambient_light(sky, ground, 0.5);
-    assert!((mid.x - 0.5 * GROUND_LIGHT_GAIN).abs() < 1e-6, "{mid}");
+    let mid = ambient_light(sky, ground, 0.5, g);
+    assert!(
+        (mid.x - 0.5 * GROUND_LIGHT_GAIN_ALONE).abs() < 1e-6,
+        "{mid}"
+    );
 }
 
 /// A ray 3° up from 60 m under the default band (579-1600 m) crosses it

@@ -11,7 +11,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::density::{band_segment, density_at};
-use super::lighting::{integrate_step, sun_scattering};
+use super::lighting::{integrate_step, light_gains, sun_scattering};
 #[cfg(doc)]
 use super::renderer::march_ray;
 use super::renderer::{
@@ -291,6 +291,7 @@ pub fn reflected_clouds(
         blur,
     } = *light_in;
     let cos = r.dot(sun_dir);
+    let gains = light_gains(fr.light.is_some());
     let steps = reflection_step_count(t1 - t0);
     let h = (t1 - t0) / steps as f32;
     let mut transmittance = 1.0_f32;
@@ -306,9 +307,9 @@ pub fn reflected_clouds(
         let tau_sun = -shadow.max(1e-30).ln();
         let eta = ((x.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
         let scatter = sun
-            * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves)
+            * (sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves, &gains)
                 + diffused_light(x, -r, q.octaves, fr))
-            + ambient_light(sky_top, ground, eta);
+            + ambient_light(sky_top, ground, eta, &gains);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= (-sigma_t * h).exp();
         if transmittance < MIN_TRANSMITTANCE {

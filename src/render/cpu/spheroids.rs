@@ -14,7 +14,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::lighting::{integrate_step, sun_scattering};
+use super::lighting::{LightGains, integrate_step, sun_scattering};
 use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, to_srgb8};
 use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
 use super::standalone::{analytic, hazed_clouds, render_standalone};
@@ -395,9 +395,17 @@ pub fn march_spheroids(
         }
         let tau_sun = light_grid_depth(p, grid);
         let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        let ambient = ambient_light(sky_top, ground, eta);
-        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves) + ambient)
-            * (sigma_t * ALBEDO);
+        let ambient = ambient_light(sky_top, ground, eta, &LightGains::ALONE);
+        let src =
+            (sun * sun_scattering(
+                tau_sun,
+                cos,
+                sun_dir.y,
+                sigma_t,
+                q.octaves,
+                &LightGains::ALONE,
+            ) + ambient)
+                * (sigma_t * ALBEDO);
         let step_t = (-sigma_t * dt).exp();
         light += integrate_step(src, sigma_t, dt) * transmittance;
         depth_weighted += t * transmittance * (1.0 - step_t);

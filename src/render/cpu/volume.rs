@@ -16,7 +16,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 
 use super::density::band_segment;
-use super::lighting::{integrate_step, shadow_ray_length, sun_scattering};
+use super::lighting::{LightGains, integrate_step, shadow_ray_length, sun_scattering};
 use super::renderer::{
     ALBEDO, Frame, MIN_TRANSMITTANCE, NEAR_M, ambient_light, march_distance, march_step_count,
 };
@@ -210,9 +210,17 @@ pub fn march_volume(
         let length = shadow_ray_length(p, sun_dir, d).min(VOLUME_SHADOW_RAY_M);
         let tau_sun = volume_optical_depth(p, sun_dir, length, params, stack);
         let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        let ambient = ambient_light(sky_top, ground, eta);
-        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves) + ambient)
-            * (sigma_t * ALBEDO);
+        let ambient = ambient_light(sky_top, ground, eta, &LightGains::ALONE);
+        let src =
+            (sun * sun_scattering(
+                tau_sun,
+                cos,
+                sun_dir.y,
+                sigma_t,
+                q.octaves,
+                &LightGains::ALONE,
+            ) + ambient)
+                * (sigma_t * ALBEDO);
         let step_t = (-sigma_t * dt).exp();
         light += integrate_step(src, sigma_t, dt) * transmittance;
         depth_weighted += t * transmittance * (1.0 - step_t);

@@ -80,6 +80,7 @@ impl GpuSettings {
                 "AERIAL_PERSPECTIVE",
                 flag(self.quality.atmosphere.aerial_perspective),
             ),
+            ("LIGHT_VOLUME", flag(self.light_volume())),
             (
                 "SEA_WIND_MPS",
                 self.quality.sea_wind_mps.unwrap_or_default() as f64,

@@ -82,6 +82,12 @@ impl StandalonePass {
         });
         let module = bind::module(device, label, source);
         let mut constants = settings.constants();
+        // No light volume here: the gains of the renderers without one.
+        for (name, value) in &mut constants {
+            if *name == "LIGHT_VOLUME" {
+                *value = 0.0;
+            }
+        }
         constants.push(("ENCODE_SRGB", (!format.is_srgb()) as u8 as f64));
         constants.push((
             "TONE_MAP",
