@@ -24,7 +24,12 @@
 # view in 15 minutes and was stopped. fit_gains.py's cache
 # is keyed by the binary, not by these: give each setting its own --cache.
 #
-# Builds the patch (transport_experiment.patch) in a worktree of HEAD at
+# The transport has shipped since (2026-12-06, third session: the light
+# volume is the l = 2 transport); the experiment stays reproducible on
+# the tree it was measured on, BEFORE (the commit below), where the
+# patch applies and the SHIPPED_PARTS were built.
+#
+# Builds the patch (transport_experiment.patch) in a worktree of BEFORE at
 # /tmp/transport_wt, with its own target directory, and writes
 # OUTDIR/cumulus_{fl,am,gr} from it (the light volume's, the sky's and
 # the ground's parts; the other four parts are linked from SHIPPED_PARTS,
@@ -38,7 +43,8 @@ wt=/tmp/transport_wt
 patch=$(pwd)/docs/ground_truth/transport_experiment.patch
 rm -rf "$wt"
 git worktree prune
-git worktree add -q --detach "$wt" HEAD
+BEFORE=03dfb3f
+git worktree add -q --detach "$wt" "$BEFORE"
 trap 'git worktree remove --force "$wt"' EXIT
 (cd "$wt" && git apply "$patch")
 mkdir -p "$out"
