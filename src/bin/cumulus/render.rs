@@ -210,8 +210,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
         single_scattering: a.single_scattering,
         ..r.quality()
     };
-    let frame = prepared.frame(r, quality);
     if let Some(dir) = &a.quality_report {
+        // The CPU's frame, its light volume built once here (the GPU
+        // builds its own: a GPU picture does not wait for the CPU's).
+        let frame = prepared.frame(r, quality);
         crate::create_output_folder(dir)?;
         let (w, h) = (r.width.min(320), r.height.min(240));
         let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");
@@ -269,6 +271,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         return render_gpu(ctx, &a, &scene, &prepared, picture);
     }
     let Some(out) = &a.out else { return Ok(()) };
+    let built = std::time::Instant::now();
+    let frame = prepared.frame(r, quality);
+    let light_s = built.elapsed().as_secs_f64();
     let start = std::time::Instant::now();
     let mut linear = render_still(r.width, r.height, &frame, r.cpu_offsets);
     if picture != Some(Picture::Exr) {
@@ -281,7 +286,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
 
     write_linear(out, picture, r, &linear)?;
     eprintln!(
-        "rendered {}x{} in {:.2} s ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        "rendered {}x{} in {:.2} s after {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
         r.height,
         elapsed.as_secs_f64(),
