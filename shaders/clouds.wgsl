@@ -914,7 +914,7 @@ fn reflected_clouds(p: vec3f, r: vec3f, t_sea: f32, dither: f32, sun_dir: vec3f,
         let shadow = cloud_shadow(x, sun_dir, REFLECTION_SHADOW_STEPS);
         let tau_sun = -log(max(shadow, 1e-30));
         let eta = clamp((x.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let diffused = FLUENCE_GAIN * light_toward(x, -r);
+        let diffused = light_gains().fluence * light_toward(x, -r);
         let scatter = sun * (sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + diffused) + ambient_light(sky_top, ground, eta);
         light += integrate_step(scatter * (sigma_t * ALBEDO), sigma_t, h) * transmittance;
         transmittance *= exp(-sigma_t * h);
@@ -1097,7 +1097,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 lit = false;
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
                 let ambient = ambient_light(sky_top, ground, eta);
-                let diffused = FLUENCE_GAIN * light_toward(lit_p, -dir);
+                let diffused = light_gains().fluence * light_toward(lit_p, -dir);
                 let scatter = sun * (sun_scattering(tau, cos_theta, sun_dir.y, lit_sigma) + diffused) + ambient;
                 let s = scatter * (lit_sigma * ALBEDO);
                 let step_t = exp(-lit_sigma * h);

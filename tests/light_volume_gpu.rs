@@ -40,14 +40,19 @@ fn mean_difference(a: &[[f32; 9]], b: &[[f32; 9]]) -> f64 {
 /// GPU reads P and the cloud map as half floats through hardware
 /// filtering) and a path that differs once goes its own way, so the
 /// twins agree statistically. The GPU's coefficients differ from the
-/// CPU's (same seed) by no more than the CPU's differ from another seed
-/// of its own (the photons' noise), times [`NOISE_RATIO`]; the layers'
+/// CPU's (same seed) by at most [`NOISE_RATIO`] of what the CPU's differ
+/// from another seed of its own (the photons' noise; measured 0.24 on
+/// fair weather and 0.22 on BOMEX: the paths stay the same photons', so
+/// a GPU drawing other random numbers, near 1, fails); the layers'
 /// totals (a whole layer's light, little noise) agree within
 /// [`LAYER_REL`]; and the planes the cloud pass samples are the GPU's
 /// sums through the phase's moments, within half-float precision.
-const NOISE_RATIO: f64 = 1.1;
+const NOISE_RATIO: f64 = 0.5;
 const LAYER_REL: f64 = 0.02;
 const PLANE_REL: f32 = 0.005;
+/// A progressive volume against a whole build of other photons, per
+/// layer (the light of the sun before the change would be a quarter).
+const PROGRESSIVE_REL: f64 = 0.03;
 
 #[test]
 fn the_gpu_light_volume_is_its_cpu_twin() {
@@ -176,12 +181,43 @@ fn a_progressive_light_volume_settles_on_the_whole_build() {
     hl.render(&ctx, &r.camera(), 2).expect("frames");
     let pass = hl.renderer.light_volume().expect("light volume");
     assert_eq!(pass.read_sh(&ctx, sun).expect("readback"), progressive);
-    // New clouds: the next frame traces a batch into the running mean.
-    hl.renderer.update_field(&ctx.queue, &p.field);
-    hl.render(&ctx, &r.camera(), 1).expect("frame");
+    // A higher sun: two full counts' worth of frames later the volume
+    // holds the new sun's light alone, as a whole build does (other
+    // photons: within the photons' noise), and then rests.
+    let mut higher = settings;
+    higher.sun_elevation_deg += 25.0;
+    let high_sun = sun_direction(higher.sun_elevation_deg, higher.sun_azimuth_deg);
+    hl.renderer.set_settings(&higher);
+    hl.render(&ctx, &r.camera(), 4).expect("frames");
     assert_eq!(hl.renderer.light_volume_builds(), Some(2));
     let pass = hl.renderer.light_volume().expect("light volume");
-    assert_ne!(pass.read_sh(&ctx, sun).expect("readback"), progressive);
+    let followed = pass.read_sh(&ctx, high_sun).expect("readback");
+    let mut whole = p
+        .headless(&ctx, &higher, r.width, r.height)
+        .expect("renderer");
+    whole.render(&ctx, &r.camera(), 1).expect("frame");
+    let pass = whole.renderer.light_volume().expect("light volume");
+    let full = pass.read_sh(&ctx, high_sun).expect("readback");
+    let grid = pass.grid;
+    let n = (grid.cells.x * grid.cells.z) as usize;
+    let total = full.iter().map(|c| c[0] as f64).sum::<f64>();
+    for j in 0..grid.cells.y as usize {
+        let layer = |v: &[[f32; 9]]| {
+            v[j * n..(j + 1) * n]
+                .iter()
+                .map(|c| c[0] as f64)
+                .sum::<f64>()
+        };
+        let (a, b) = (layer(&followed), layer(&full));
+        let scale = b.max(0.05 * total / grid.cells.y as f64);
+        assert!(
+            (a - b).abs() < PROGRESSIVE_REL * scale,
+            "layer {j}: progressive {a} vs whole {b}"
+        );
+    }
+    hl.render(&ctx, &r.camera(), 1).expect("frame");
+    let pass = hl.renderer.light_volume().expect("light volume");
+    assert_eq!(pass.read_sh(&ctx, high_sun).expect("readback"), followed);
 }
 
 /// The volume is built when P, the sun or the density change, not per

@@ -491,8 +491,17 @@ mod tests {
         let (grid, sigma) = layer(0.03, 6);
         let sun = Vec3::new(0.3, 0.8, 0.2).normalize();
         let a = trace(&grid, &sigma, sun, 20_000, 9);
-        let b = trace(&grid, &sigma, sun, 20_000, 9);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .expect("a pool of one thread");
+        let b = one.install(|| trace(&grid, &sigma, sun, 20_000, 9));
         assert_eq!(a, b);
+        let three = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("a pool of three threads");
+        assert_eq!(a, three.install(|| trace(&grid, &sigma, sun, 20_000, 9)));
         let c = trace(&grid, &sigma, sun, 20_000, 10);
         assert_ne!(a, c);
     }

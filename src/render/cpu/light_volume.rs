@@ -14,7 +14,7 @@
 //! 2. [`super::light_transport::trace`]: [`light_photons`] photons from
 //!    the sun through those cells, their tracks summed as nine
 //!    coefficients a cell (`follow` on the GPU, into fixed-point cells);
-//!    then [`sh_planes`] (`sh_texture` on the GPU): the coefficients
+//!    then [`sh_planes`] (the entry of that name on the GPU): the coefficients
 //!    scaled to per unit irradiance and convolved with the phase
 //!    function ([`PHASE_MOMENTS`]), in the three rgba planes the cloud
 //!    pass samples.
@@ -123,8 +123,8 @@ impl LightVolumeGrid {
     }
 }
 
-/// Reads `values` (one per cell of `grid`: the extinction, the fluence or
-/// the flux) trilinearly at `p`: wrapping across the domain, clamped to
+/// Reads `values` (one per cell of `grid`: the extinction or a plane of
+/// the transported light) trilinearly at `p`: wrapping across the domain, clamped to
 /// the band's outer cell centres (`read_cells` in WGSL).
 #[inline]
 pub fn read_cells<T: Cell>(values: &[T], grid: &LightVolumeGrid, p: Vec3) -> T {
@@ -171,7 +171,6 @@ pub fn cell_extinction(grid: &LightVolumeGrid, f: &Fields, d: &DensityParams) ->
         .collect()
 }
 
-/// The sun's height below which the layers' recursion stops: a sun this
 /// Reads one layer's `values` bilinearly at world `(x, z)`, wrapping.
 #[inline]
 pub fn read_layer<T: Cell>(values: &[T], grid: &LightVolumeGrid, x: f32, z: f32) -> T {
@@ -191,7 +190,7 @@ pub fn read_layer<T: Cell>(values: &[T], grid: &LightVolumeGrid, x: f32, z: f32)
 /// The cloud pass's three planes from the radiance coefficients `sh` (per
 /// unit irradiance, [`trace`]'s): each coefficient times its band's
 /// [`PHASE_MOMENTS`], coefficients 0-3, 4-7 and 8 (then zeros) in turn
-/// (`sh_texture` in WGSL). The light scattered toward `ω` is the dot
+/// (the `sh_planes` entry in WGSL). The light scattered toward `ω` is the dot
 /// product of the planes with [`sh9`]`(ω)`.
 pub fn sh_planes(sh: &[[f32; 9]]) -> [Vec<Vec4>; 3] {
     let c = |v: &[f32; 9], k: usize| v[k] * PHASE_MOMENTS[SH_BAND[k]];

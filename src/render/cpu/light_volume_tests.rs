@@ -50,6 +50,29 @@ fn the_planes_scatter_the_light_through_the_phase() {
         let got = v.light_toward(p, d, 400.0);
         assert!((got - radiance).abs() < 1e-5, "{d}: {got}");
     }
+    // A different light in every cell: a cell's centre reads its own.
+    let sh: Vec<[f32; 9]> = (0..g.len())
+        .map(|i| std::array::from_fn(|k| 0.1 * (i as f32 + 1.0) * (1.0 + k as f32 * 0.05)))
+        .collect();
+    let planes = sh_planes(&sh);
+    let v = LightVolume {
+        grid: g,
+        planes,
+        sh: sh.clone(),
+    };
+    for (i, j, k) in [(0, 0, 0), (1, 2, 3), (3, 1, 2)] {
+        let c = &sh[g.index(i, j, k)];
+        let d = Vec3::new(0.48, 0.6, 0.64);
+        let y = crate::render::cpu::light_transport::sh9(d);
+        let expected: f32 = (0..9)
+            .map(|n| c[n] * PHASE_MOMENTS[SH_BAND[n]] * y[n])
+            .sum();
+        let got = v.light_toward(g.centre(i, j, k), d, 400.0);
+        assert!(
+            (got - expected).abs() < 1e-4 * expected.abs(),
+            "cell ({i}, {j}, {k}): {got} vs {expected}"
+        );
+    }
     // A beam straight down: l = 1 along -y.
     let mut sh = vec![[0.0f32; 9]; g.len()];
     for c in &mut sh {

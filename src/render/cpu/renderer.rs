@@ -11,8 +11,8 @@ use super::density::{DensityParams, Fields, band_segment, density_at};
 use super::land::{flat_ground_albedo, terrain_albedo};
 use super::light_volume::LightVolume;
 use super::lighting::{
-    FLUENCE_GAIN, LightGains, ShadowSteps, forward_step_factor, integrate_step, light_gains,
-    shadow_offset, sun_optical_depth, sun_scattering,
+    LightGains, ShadowSteps, forward_step_factor, integrate_step, light_gains, shadow_offset,
+    sun_optical_depth, sun_scattering,
 };
 use super::sea::sea_reflection_change;
 use super::sky::{
@@ -106,9 +106,11 @@ pub struct Frame<'a> {
     /// sunlight the clouds scatter down onto the land
     /// ([`super::sky::ground_cloud_light`]).
     pub cloud_cover: f32,
-    /// The sunlight diffused through the clouds ([`LightVolume`], built
-    /// for this frame's field, density and sun; none: the term is left
-    /// out, as with no octaves).
+    /// The sunlight scattered more than once through the clouds
+    /// ([`LightVolume`], built for this frame's field, density and sun;
+    /// none: the term is left out, as with no octaves, and the light
+    /// takes the gains of a renderer without one,
+    /// [`super::lighting::LightGains::ALONE`]).
     pub light: Option<&'a LightVolume>,
 }
 
@@ -205,7 +207,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// 4`), 0.35 of it at the band's bottom and all of it at its top
 /// ([`ambient_light`]), times this, which stands for that light's own
 /// multiple scattering; fitted with the octaves and the transported
-/// sunlight ([`super::lighting::sun_scattering`], [`FLUENCE_GAIN`]) and
+/// sunlight ([`super::lighting::sun_scattering`], [`super::lighting::FLUENCE_GAIN`]) and
 /// [`GROUND_LIGHT_GAIN`] (4.37 beside the diffusion).
 pub const AMBIENT_GAIN: f32 = 4.626;
 /// [`AMBIENT_GAIN`] where no light volume is built
@@ -372,13 +374,15 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
 
 /// The light volume's transported sunlight at `p` scattered toward the
 /// eye (`to_eye`, against the ray), per unit scattering coefficient and
-/// sun irradiance ([`LightVolume::light_toward`] times
-/// [`FLUENCE_GAIN`]): 0 without one or without multiple scattering
+/// sun irradiance ([`LightVolume::light_toward`] times the transport's
+/// gain, [`super::lighting::FLUENCE_GAIN`]): 0 without one or without multiple scattering
 /// (`octaves` 0).
 #[inline]
 pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
     match fr.light {
-        Some(v) if octaves > 0 => FLUENCE_GAIN * v.light_toward(p, to_eye, fr.density.map_extent_m),
+        Some(v) if octaves > 0 => {
+            LightGains::TRANSPORT.fluence * v.light_toward(p, to_eye, fr.density.map_extent_m)
+        }
         _ => 0.0,
     }
 }

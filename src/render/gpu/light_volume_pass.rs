@@ -78,6 +78,19 @@ fn workgroups(n: u32) -> (u32, u32) {
     }
 }
 
+/// The weight of a progressive frame's batch in the sums (what they keep
+/// is one less it), `since_change` batches after the last change, whose
+/// exact mean starts `mean_from` batches after it, in a full count of
+/// `window` batches: before `mean_from` a running mean over `window`
+/// batches, from it the mean of the batches since.
+fn progressive_weight(since_change: u32, mean_from: u32, window: u32) -> f32 {
+    if since_change >= mean_from {
+        1.0 / (since_change - mean_from + 1) as f32
+    } else {
+        1.0 / window.max(1) as f32
+    }
+}
+
 /// The batches of `photons`: each batch's first photon and count.
 fn batches(photons: u32, batch: u32) -> Vec<(u32, u32)> {
     let batch = batch.max(1);
@@ -120,9 +133,13 @@ pub struct LightVolumePass {
     /// One batch per frame into a running mean (see
     /// [`Self::set_progressive`]), else whole builds.
     progressive: bool,
-    /// Progressive: batches folded since the volume was made, and the
-    /// batches still to trace before it rests.
+    /// Progressive: batches folded since the volume was made (they number
+    /// the photons), since the last change, the batch from which that
+    /// change's exact mean starts, and the batches still to trace before
+    /// the volume rests.
     traced: u32,
+    since_change: u32,
+    mean_from: u32,
     pending: u32,
     pipelines: Option<Pipelines>,
     stale: bool,
@@ -320,6 +337,8 @@ impl LightVolumePass {
             fold,
             progressive: false,
             traced: 0,
+            since_change: 0,
+            mean_from: 0,
             pending: 0,
             pipelines: None,
             stale: true,
@@ -335,18 +354,22 @@ impl LightVolumePass {
 
     /// Progressive building, for an interactive frame loop: each frame
     /// whose volume is stale or still settling traces one batch
-    /// ([`BATCH_PER_COLUMN`] photons a column) into a running mean of the
-    /// last full count's worth (the mean of all batches until there are
-    /// that many), and a change of the clouds or the sun starts a full
-    /// count's worth of batches more, one a frame: the light follows
-    /// slowly changing clouds over that many frames, for a frame's cost
-    /// of one batch. Off (the default): a stale volume is built whole
-    /// before the frame (stills, tests, benchmarks). Switching starts
-    /// afresh.
+    /// ([`BATCH_PER_COLUMN`] photons a column, a full count being
+    /// `window` batches), folded in by [`progressive_weight`]. A new
+    /// volume is the mean of its batches so far. After a change of the
+    /// clouds or the sun the next `window` batches follow it as a running
+    /// mean over `window` batches (the light lags slowly changing clouds
+    /// by about that many frames), and the `window` after those, if
+    /// nothing changes again, make the exact mean of the new light alone;
+    /// then the volume rests. A frame costs one batch. Off (the default):
+    /// a stale volume is built whole before the frame (stills, tests,
+    /// benchmarks). Switching starts afresh.
     pub fn set_progressive(&mut self, on: bool) {
         if self.progressive != on {
             self.progressive = on;
             self.traced = 0;
+            self.since_change = 0;
+            self.mean_from = 0;
             self.pending = 0;
             self.stale = true;
         }
@@ -520,9 +543,9 @@ impl LightVolumePass {
 
 impl LightVolumePass {
     /// One progressive frame ([`Self::set_progressive`]): when the volume
-    /// is stale, the cells' extinction anew and a full count of batches to
-    /// come; while batches are to come, one, folded into the running
-    /// mean, and the planes.
+    /// is stale, the cells' extinction anew and the batches to come; while
+    /// batches are to come, one, folded into the sums by
+    /// [`progressive_weight`], and the planes.
     fn build_progressively(
         &mut self,
         device: &wgpu::Device,
@@ -531,11 +554,18 @@ impl LightVolumePass {
         group0: &wgpu::BindGroup,
         constants: &[(&str, f64)],
     ) {
+        let window = self.batch_count().max(1);
         let fresh = self.stale;
         if fresh {
             self.stale = false;
             self.builds += 1;
-            self.pending = self.batch_count();
+            // A new volume: the mean of its first `window` batches. A
+            // change: a running mean over `window` batches that follows
+            // the clouds while they keep changing, then, once they rest,
+            // the exact mean of `window` batches of the new light alone.
+            self.mean_from = if self.traced == 0 { 0 } else { window };
+            self.since_change = 0;
+            self.pending = self.mean_from + window;
         }
         if self.pending == 0 {
             return;
@@ -544,10 +574,8 @@ impl LightVolumePass {
             return;
         };
         let total = self.batches.iter().map(|b| b.1).sum::<u32>();
-        let window = self.batch_count().max(1);
-        // The mean of the batches so far, then of the last `window`; each
-        // batch's tracks scaled to the full count's.
-        let w = 1.0 / (self.traced + 1).min(window) as f32;
+        // Each batch's tracks scaled to the full count's.
+        let w = progressive_weight(self.since_change, self.mean_from, window);
         let gain = w * total as f32 / batch as f32;
         queue.write_buffer(
             &self.fold,
@@ -559,6 +587,7 @@ impl LightVolumePass {
         let last = self.batches.len() as u64 * STEP_STRIDE;
         queue.write_buffer(&self.steps, last, bytemuck::bytes_of(&entry));
         self.traced += 1;
+        self.since_change += 1;
         self.pending -= 1;
         let p = pipelines(
             &mut self.pipelines,
@@ -653,6 +682,34 @@ mod tests {
                 (x * LIGHT_WORKGROUP - 1) + (y - 1) * ROW * LIGHT_WORKGROUP >= n - 1,
                 "{n}"
             );
+        }
+    }
+
+    #[test]
+    fn a_progressive_volume_forgets_the_light_before_a_change() {
+        // The share of the sums from before the change after each batch:
+        // it falls while the running mean follows and is 0 once the exact
+        // mean starts; a fresh volume's first batch keeps nothing.
+        let window = 16;
+        assert_eq!(progressive_weight(0, 0, window), 1.0);
+        let mut old = 1.0f32;
+        for k in 0..2 * window {
+            let w = progressive_weight(k, window, window);
+            old *= 1.0 - w;
+            if k < window {
+                assert!(old > 0.0 && old < 1.0);
+            }
+        }
+        assert_eq!(old, 0.0);
+        // The exact mean: every batch after `mean_from` weighs the same.
+        let mut shares = vec![];
+        for k in window..2 * window {
+            let w = progressive_weight(k, window, window);
+            shares.iter_mut().for_each(|s: &mut f32| *s *= 1.0 - w);
+            shares.push(w);
+        }
+        for s in &shares {
+            assert!((s - 1.0 / window as f32).abs() < 1e-6, "{shares:?}");
         }
     }
 

@@ -12,7 +12,9 @@
 //!    heightfield mesh into an HDR colour target and a depth buffer.
 //! 2. `light_volume` (multiple scattering on, [`super::light_volume_pass`]):
 //!    compute passes submitted before the frame's, only when P, the sun or
-//!    the density changed: the sunlight diffused through the clouds.
+//!    the density changed (progressively, one batch of photons a frame,
+//!    after [`CloudRenderer::set_progressive_light`]): the sunlight
+//!    transported through the clouds.
 //! 3. `clouds` (`cloud_pass`): full-screen; marches the band
 //!    segment of each ray up to the depth (terrain or an external depth
 //!    buffer) into the cloud layer (premultiplied radiance, opacity) and,
@@ -385,8 +387,9 @@ impl CloudRenderer {
     /// Builds the light volume one batch of photons a frame into a running
     /// mean ([`LightVolumePass::set_progressive`]), for an interactive
     /// loop whose clouds change every few frames: a frame costs one
-    /// batch (1/16 of the default count) instead of a whole build, and the
-    /// light settles over 16 frames. Off by default (stills, tests and
+    /// batch (1/16 of the default count) instead of a whole build; the
+    /// light follows changing clouds over about 16 frames and, once they
+    /// rest, holds the new light alone 32 frames after the change. Off by default (stills, tests and
     /// `cumulus bench` build it whole).
     pub fn set_progressive_light(&mut self, on: bool) {
         self.progressive_light = on;
