@@ -355,7 +355,7 @@ impl LightVolumePass {
     /// Progressive building, for an interactive frame loop: each frame
     /// whose volume is stale or still settling traces one batch
     /// ([`BATCH_PER_COLUMN`] photons a column, a full count being
-    /// `window` batches), folded in by [`progressive_weight`]. A new
+    /// `window` batches), folded in by `progressive_weight`. A new
     /// volume is the mean of its batches so far. After a change of the
     /// clouds or the sun the next `window` batches follow it as a running
     /// mean over `window` batches (the light lags slowly changing clouds
