@@ -210,17 +210,11 @@ pub fn march_volume(
         let length = shadow_ray_length(p, sun_dir, d).min(VOLUME_SHADOW_RAY_M);
         let tau_sun = volume_optical_depth(p, sun_dir, length, params, stack);
         let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        let ambient = ambient_light(sky_top, ground, eta, &LightGains::ALONE);
-        let src =
-            (sun * sun_scattering(
-                tau_sun,
-                cos,
-                sun_dir.y,
-                sigma_t,
-                q.octaves,
-                &LightGains::ALONE,
-            ) + ambient)
-                * (sigma_t * ALBEDO);
+        // No light volume here: the gains of the renderers without one.
+        let g = &LightGains::ALONE;
+        let ambient = ambient_light(sky_top, ground, eta, g);
+        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves, g) + ambient)
+            * (sigma_t * ALBEDO);
         let step_t = (-sigma_t * dt).exp();
         light += integrate_step(src, sigma_t, dt) * transmittance;
         depth_weighted += t * transmittance * (1.0 - step_t);

@@ -78,19 +78,6 @@ fn workgroups(n: u32) -> (u32, u32) {
     }
 }
 
-/// The weight of a progressive frame's batch in the sums (what they keep
-/// is one less it), `since_change` batches after the last change, whose
-/// exact mean starts `mean_from` batches after it, in a full count of
-/// `window` batches: before `mean_from` a running mean over `window`
-/// batches, from it the mean of the batches since.
-fn progressive_weight(since_change: u32, mean_from: u32, window: u32) -> f32 {
-    if since_change >= mean_from {
-        1.0 / (since_change - mean_from + 1) as f32
-    } else {
-        1.0 / window.max(1) as f32
-    }
-}
-
 /// The batches of `photons`: each batch's first photon and count.
 fn batches(photons: u32, batch: u32) -> Vec<(u32, u32)> {
     let batch = batch.max(1);
@@ -354,16 +341,14 @@ impl LightVolumePass {
 
     /// Progressive building, for an interactive frame loop: each frame
     /// whose volume is stale or still settling traces one batch
-    /// ([`BATCH_PER_COLUMN`] photons a column, a full count being
-    /// `window` batches), folded in by `progressive_weight`. A new
-    /// volume is the mean of its batches so far. After a change of the
-    /// clouds or the sun the next `window` batches follow it as a running
-    /// mean over `window` batches (the light lags slowly changing clouds
-    /// by about that many frames), and the `window` after those, if
-    /// nothing changes again, make the exact mean of the new light alone;
-    /// then the volume rests. A frame costs one batch. Off (the default):
-    /// a stale volume is built whole before the frame (stills, tests,
-    /// benchmarks). Switching starts afresh.
+    /// ([`BATCH_PER_COLUMN`] photons a column; a full count is `window`
+    /// batches). A new volume is the mean of its batches so far. After a
+    /// change of the clouds or the sun, the next `window` batches follow
+    /// it as a running mean (the light lags changing clouds by about that
+    /// many frames) and, if nothing changes again, the `window` after
+    /// them make the exact mean of the new light alone; then it rests.
+    /// Off (the default): a stale volume is built whole before the frame
+    /// (stills, tests, benchmarks). Switching starts afresh.
     pub fn set_progressive(&mut self, on: bool) {
         if self.progressive != on {
             self.progressive = on;
@@ -500,6 +485,32 @@ impl LightVolumePass {
             0,
             bytemuck::cast_slice(&[1.0f32, 1.0, 0.0, 0.0]),
         );
+        let batches: Vec<(u32, u32)> = (0..self.batches.len())
+            .map(|e| ((e as u64 * STEP_STRIDE) as u32, self.batches[e].1))
+            .collect();
+        self.record(
+            device,
+            queue,
+            (group0_layout, group0),
+            constants,
+            (true, true),
+            &batches,
+        );
+    }
+
+    /// Records and submits a build: with `clear`, the tracks and sums
+    /// cleared, with `extinction`, the cells' extinction anew; then each
+    /// of `batches` (its `light_step` entry's offset and its photons)
+    /// traced and folded; last the planes.
+    fn record(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (group0_layout, group0): (&wgpu::BindGroupLayout, &wgpu::BindGroup),
+        constants: &[(&str, f64)],
+        (clear, extinction): (bool, bool),
+        batches: &[(u32, u32)],
+    ) {
         let p = pipelines(
             &mut self.pipelines,
             &self.build_layout,
@@ -513,111 +524,32 @@ impl LightVolumePass {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some(PASS_LIGHT_VOLUME),
         });
-        encoder.clear_buffer(&self.tracks, 0, None);
-        encoder.clear_buffer(&self.sums, 0, None);
+        if clear {
+            encoder.clear_buffer(&self.tracks, 0, None);
+            encoder.clear_buffer(&self.sums, 0, None);
+        }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(PASS_LIGHT_VOLUME),
                 timestamp_writes: None,
             });
             pass.set_bind_group(0, group0, &[]);
-            let step = |e: usize| [(e as u64 * STEP_STRIDE) as u32];
-            pass.set_pipeline(&p.cell_extinction);
-            pass.set_bind_group(1, &self.build_group, &step(0));
-            pass.dispatch_workgroups(all.0, all.1, 1);
-            for (e, (_, count)) in self.batches.iter().enumerate() {
-                let photons = workgroups(*count);
+            // Every entry holds the whole count (`z`), which the
+            // extinction ignores and the planes read.
+            let first = batches.first().map_or(0, |b| b.0);
+            pass.set_bind_group(1, &self.build_group, &[first]);
+            if extinction {
+                pass.set_pipeline(&p.cell_extinction);
+                pass.dispatch_workgroups(all.0, all.1, 1);
+            }
+            for &(offset, count) in batches {
+                let photons = workgroups(count);
                 pass.set_pipeline(&p.trace);
-                pass.set_bind_group(1, &self.build_group, &step(e));
+                pass.set_bind_group(1, &self.build_group, &[offset]);
                 pass.dispatch_workgroups(photons.0, photons.1, 1);
                 pass.set_pipeline(&p.fold_tracks);
                 pass.dispatch_workgroups(words.0, words.1, 1);
             }
-            pass.set_pipeline(&p.sh_planes);
-            pass.set_bind_group(1, &self.build_group, &step(0));
-            pass.dispatch_workgroups(all.0, all.1, 1);
-        }
-        queue.submit([encoder.finish()]);
-    }
-}
-
-impl LightVolumePass {
-    /// One progressive frame ([`Self::set_progressive`]): when the volume
-    /// is stale, the cells' extinction anew and the batches to come; while
-    /// batches are to come, one, folded into the sums by
-    /// [`progressive_weight`], and the planes.
-    fn build_progressively(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        group0_layout: &wgpu::BindGroupLayout,
-        group0: &wgpu::BindGroup,
-        constants: &[(&str, f64)],
-    ) {
-        let window = self.batch_count().max(1);
-        let fresh = self.stale;
-        if fresh {
-            self.stale = false;
-            self.builds += 1;
-            // A new volume: the mean of its first `window` batches. A
-            // change: a running mean over `window` batches that follows
-            // the clouds while they keep changing, then, once they rest,
-            // the exact mean of `window` batches of the new light alone.
-            self.mean_from = if self.traced == 0 { 0 } else { window };
-            self.since_change = 0;
-            self.pending = self.mean_from + window;
-        }
-        if self.pending == 0 {
-            return;
-        }
-        let Some(&(_, batch)) = self.batches.first() else {
-            return;
-        };
-        let total = self.batches.iter().map(|b| b.1).sum::<u32>();
-        // Each batch's tracks scaled to the full count's.
-        let w = progressive_weight(self.since_change, self.mean_from, window);
-        let gain = w * total as f32 / batch as f32;
-        queue.write_buffer(
-            &self.fold,
-            0,
-            bytemuck::cast_slice(&[1.0 - w, gain, 0.0, 0.0]),
-        );
-        let first = self.traced.wrapping_mul(batch);
-        let entry: [u32; 4] = [first, batch, total, 0];
-        let last = self.batches.len() as u64 * STEP_STRIDE;
-        queue.write_buffer(&self.steps, last, bytemuck::bytes_of(&entry));
-        self.traced += 1;
-        self.since_change += 1;
-        self.pending -= 1;
-        let p = pipelines(
-            &mut self.pipelines,
-            &self.build_layout,
-            device,
-            group0_layout,
-            constants,
-        );
-        let g = &self.grid;
-        let all = workgroups(g.len() as u32);
-        let words = workgroups(9 * g.len() as u32);
-        let photons = workgroups(batch);
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some(PASS_LIGHT_VOLUME),
-        });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(PASS_LIGHT_VOLUME),
-                timestamp_writes: None,
-            });
-            pass.set_bind_group(0, group0, &[]);
-            pass.set_bind_group(1, &self.build_group, &[last as u32]);
-            if fresh {
-                pass.set_pipeline(&p.cell_extinction);
-                pass.dispatch_workgroups(all.0, all.1, 1);
-            }
-            pass.set_pipeline(&p.trace);
-            pass.dispatch_workgroups(photons.0, photons.1, 1);
-            pass.set_pipeline(&p.fold_tracks);
-            pass.dispatch_workgroups(words.0, words.1, 1);
             pass.set_pipeline(&p.sh_planes);
             pass.dispatch_workgroups(all.0, all.1, 1);
         }
@@ -659,71 +591,9 @@ fn pipelines<'a>(
     })
 }
 
+#[path = "light_volume_progressive.rs"]
+mod progressive;
+
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn folded_dispatches_cover_every_invocation() {
-        for n in [
-            1,
-            63,
-            64,
-            65,
-            4096 * 64,
-            4096 * 64 + 1,
-            1_769_472,
-            16_257_024,
-        ] {
-            let (x, y) = workgroups(n);
-            assert!(x <= 65_535 && y <= 65_535);
-            // `light_invocation`: id.x + id.y · ROW · 64 reaches n - 1.
-            assert!(
-                (x * LIGHT_WORKGROUP - 1) + (y - 1) * ROW * LIGHT_WORKGROUP >= n - 1,
-                "{n}"
-            );
-        }
-    }
-
-    #[test]
-    fn a_progressive_volume_forgets_the_light_before_a_change() {
-        // The share of the sums from before the change after each batch:
-        // it falls while the running mean follows and is 0 once the exact
-        // mean starts; a fresh volume's first batch keeps nothing.
-        let window = 16;
-        assert_eq!(progressive_weight(0, 0, window), 1.0);
-        let mut old = 1.0f32;
-        for k in 0..2 * window {
-            let w = progressive_weight(k, window, window);
-            old *= 1.0 - w;
-            if k < window {
-                assert!(old > 0.0 && old < 1.0);
-            }
-        }
-        assert_eq!(old, 0.0);
-        // The exact mean: every batch after `mean_from` weighs the same.
-        let mut shares = vec![];
-        for k in window..2 * window {
-            let w = progressive_weight(k, window, window);
-            shares.iter_mut().for_each(|s: &mut f32| *s *= 1.0 - w);
-            shares.push(w);
-        }
-        for s in &shares {
-            assert!((s - 1.0 / window as f32).abs() < 1e-6, "{shares:?}");
-        }
-    }
-
-    #[test]
-    fn the_batches_cover_every_photon_once() {
-        for (photons, batch) in [(0, 64), (1, 64), (640, 64), (641, 64), (1000, 1)] {
-            let b = batches(photons, batch);
-            let mut next = 0;
-            for (first, count) in &b {
-                assert_eq!(*first, next);
-                assert!(*count >= 1 && *count <= batch);
-                next += count;
-            }
-            assert_eq!(next, photons);
-        }
-    }
-}
+#[path = "light_volume_pass_tests.rs"]
+mod tests;
