@@ -23,7 +23,11 @@ fn scene(name: &str) -> Scene {
         Scene::load(std::path::Path::new(&format!("scenes/{name}.toml"))).expect("shipped scene");
     // A quick light volume: the scenes' 1024 photons a column take a
     // minute to build on lavapipe, and no test here measures the light.
-    sc.render.light_photons = 16;
+    // 64, not 16: the GPU's photons follow the CPU's random numbers, but
+    // a few part ways by rounding, and with 16 a column (cells 40 m
+    // tall) the view from the ground had 0.744 of its channels equal,
+    // under `PARITY_EQUAL`.
+    sc.render.light_photons = 64;
     sc
 }
 
@@ -72,7 +76,8 @@ const PARITY_OUTLIERS_TERRAIN: f64 = 0.012;
 /// GPU against CPU, the least fraction of channels with the very same
 /// byte: both dither the 8-bit output by the pixel's index
 /// (`output_dither`), so equal values round the same way. Measured on
-/// lavapipe: 0.82-0.91 over the parity views; with the GPU's dither
+/// lavapipe: 0.79-0.91 over the parity views (the least from the
+/// ground, under the light volume's cloud bases); with the GPU's dither
 /// turned off (and the CPU's on) 0.62-0.66, which the mean, 0.0013-0.0016,
 /// did not catch.
 const PARITY_EQUAL: f64 = 0.75;

@@ -42,7 +42,7 @@ PARTS = ["mf", "mi", "di", "fl", "am", "gr"]
 
 def render(binary, name, width, height, ss, extra, tmp):
     """Our linear image of view `name` by `binary`, averaged per pixel."""
-    _, base, el, az, yaw = next(v for v in C.VIEWS if v[0] == name)
+    _, base, el, az, yaw = next(v for v in C.ALL_VIEWS if v[0] == name)
     scene = os.path.join(C.ROOT, "scenes", f".fit_{name}_{os.getpid()}.toml")
     C.scene_variant(base, el, az, yaw, width * ss, height * ss, scene,
                     {**C.VIEW_CAMERA.get(name, {}), **extra})

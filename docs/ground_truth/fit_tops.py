@@ -28,26 +28,32 @@ def main():
     ap.add_argument("--cache", required=True, help="fit_gains.py's --cache, holding their renders")
     ap.add_argument("--arrays", required=True, help="compare.py --arrays output")
     ap.add_argument("--views", default="backlit,high_sun,low_sun")
+    ap.add_argument("--held-out", default="",
+                    help="views scored at the fitted gains but left out of the fit")
     ap.add_argument("--tops-band", type=float, default=0.095)
     a = ap.parse_args()
     data = {}
-    for v in a.views.split(","):
+    fitted = a.views.split(",")
+    held_out = [v for v in a.held_out.split(",") if v]
+    for v in fitted + held_out:
         truth = np.load(os.path.join(a.arrays, f"{v}_mitsuba.npy"))
         cloud = np.load(os.path.join(a.arrays, f"{v}_cloud.npy"))
         zero = T.part(a.cache, a.bins, v, "zero")
         parts = np.stack([T.part(a.cache, a.bins, v, p) - zero for p in T.PARTS], -1)
         data[v] = (truth[cloud] @ Y, zero[cloud] @ Y, np.einsum("nck,c->nk", parts[cloud], Y))
 
-    def scores(g):
+    def scores(g, views=fitted):
         out = []
-        for ym, z, parts in data.values():
+        for v in views:
+            ym, z, parts = data[v]
             yo = z + parts @ g
             rel = (yo - ym) / ym
-            out.append((np.abs(rel).mean(), np.percentile(yo, 99) / np.percentile(ym, 99)))
+            out.append((np.abs(rel).mean(), np.percentile(yo, 99) / np.percentile(ym, 99),
+                        rel.mean()))
         return out
 
     def objective(g):
-        s = scores(np.maximum(g, 0))
+        s = [(e, t) for e, t, _ in scores(np.maximum(g, 0))]
         return sum(e + 10 * max(0.0, abs(t - 1) - a.tops_band) for e, t in s)
 
     rng = np.random.default_rng(0)
@@ -60,8 +66,9 @@ def main():
                 for s in starts), key=lambda r: r.fun)
     g = np.maximum(best.x, 0)
     print("gains " + " ".join(f"{x:.3f}" for x in g))
-    for v, (e, t) in zip(data, scores(g)):
-        print(f"  {v:9s} error {e:.4f}  tops {t:.3f}")
+    for v, (e, t, b) in zip(fitted + held_out, scores(g, fitted + held_out)):
+        note = "  (held out)" if v in held_out else ""
+        print(f"  {v:9s} error {e:.4f}  bias {b:+.4f}  tops {t:.3f}{note}")
 
 
 if __name__ == "__main__":

@@ -82,7 +82,7 @@ pub struct RenderSettings {
     /// scattering off, the sunlight diffused through the layer and the
     /// light volume with it.
     pub octaves: u32,
-    /// Photons the light volume traces per column of its 80 m cells
+    /// Photons the light volume traces per column of its cells (80 m wide)
     /// (0..=65536; [`crate::render::cpu::light_volume`]). Default 1024: 16
     /// M photons over the fair-weather domain, the count the light was
     /// fitted with; fewer give a noisier light (256 scored 0.6 points

@@ -220,15 +220,15 @@ pub const OCTAVE_ECCENTRICITY: f32 = 0.9;
 /// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`],
 /// [`FLUENCE_GAIN`] and the sky's and the ground's gains are;
 /// docs/ground_truth).
-pub const MULTIPLE_GAIN: f32 = 0.254;
+pub const MULTIPLE_GAIN: f32 = 0.202;
 /// [`MULTIPLE_GAIN`] where no light volume is built ([`LightGains::ALONE`]).
 pub const MULTIPLE_GAIN_ALONE: f32 = 0.53;
 /// The gain on the octaves' isotropic light: light scattered many times
 /// leaves a cloud in every direction, not only in the phase's lobes. It
 /// was 0.91 before the light volume, which now carries most of that
 /// light ([`FLUENCE_GAIN`]); beside the transported light the fit keeps
-/// 0.508 of it, for the light near the sunlit skin the 80 m cells blur.
-pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.508;
+/// 0.256 of it, for the light near the sunlit skin the cells blur.
+pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.256;
 /// [`MULTIPLE_ISOTROPIC_GAIN`] where no light volume is built.
 pub const MULTIPLE_ISOTROPIC_GAIN_ALONE: f32 = 0.46;
 /// The octaves scale with the sun's height as
@@ -249,9 +249,9 @@ pub const MULTIPLE_SUN_POWER: f32 = 0.2;
 /// 2026-12-04 and 2026-12-05), for the renderers that build no light
 /// volume (the spheroids' and the volume's), which have only this to
 /// fill deep cloud; beside the transported light the fit with the tops
-/// held gives 0.045 (2026-12-06), and those renderers' deep cloud is that
+/// held gives 0.019 (2026-12-06), and those renderers' deep cloud is that
 /// much darker: they take [`DIFFUSE_GAIN_ALONE`] ([`LightGains`]).
-pub const DIFFUSE_GAIN: f32 = 0.045;
+pub const DIFFUSE_GAIN: f32 = 0.019;
 /// [`DIFFUSE_GAIN`] where no light volume is built.
 pub const DIFFUSE_GAIN_ALONE: f32 = 0.1;
 /// A sample carries the diffused sunlight in proportion to its opacity
@@ -279,12 +279,13 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32, gains: &LightGains) -> f32 {
 
 /// The gain on the light volume's transported sunlight
 /// ([`super::light_volume::LightVolume::light_toward`]; `FLUENCE_GAIN` in
-/// WGSL), fitted with the others: 0.766, where exact transport would need
-/// 1 and the octaves took nothing from it. The 80 m cells blur a cloud's
+/// WGSL), fitted with the others: 0.915, where exact transport would need
+/// 1 and the octaves took nothing from it. The cells blur a cloud's
 /// sunlit skin into its shaded inside, where the light is weaker: the
 /// octaves carry the skin's light, and the volume gives some of that back.
-/// (The diffusion it replaced, 2026-12-06, asked for 1.19.)
-pub const FLUENCE_GAIN: f32 = 0.766;
+/// (0.766 with cells 80 m tall; the diffusion it replaced, 2026-12-06,
+/// asked for 1.19.)
+pub const FLUENCE_GAIN: f32 = 0.915;
 
 /// The six fitted gains of the light (`light_gains` in WGSL, which picks
 /// them by its `LIGHT_VOLUME` override): the octaves' forward and

@@ -209,7 +209,7 @@ pub const SUN_INTENSITY: f32 = 8.0;
 /// multiple scattering; fitted with the octaves and the transported
 /// sunlight ([`super::lighting::sun_scattering`], [`super::lighting::FLUENCE_GAIN`]) and
 /// [`GROUND_LIGHT_GAIN`] (4.37 beside the diffusion).
-pub const AMBIENT_GAIN: f32 = 4.626;
+pub const AMBIENT_GAIN: f32 = 4.355;
 /// [`AMBIENT_GAIN`] where no light volume is built
 /// ([`super::lighting::LightGains::ALONE`]).
 pub const AMBIENT_GAIN_ALONE: f32 = 4.37;

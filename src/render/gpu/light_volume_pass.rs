@@ -52,7 +52,7 @@ const PLANE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The fixed-point cells' unit, m of track (`TRACK_UNIT` in WGSL): a
 /// track's length times its harmonic is rounded to it, far below the
-/// cells' 80 m.
+/// cells' 40 m.
 pub const TRACK_UNIT: f32 = 1.0 / 256.0;
 /// Photons per column of cells in one batch: its tracks are folded into
 /// the float sums before the next batch, so no cell's 32-bit sum
