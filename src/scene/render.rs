@@ -85,7 +85,7 @@ pub struct RenderSettings {
     /// Photons the light volume traces per column of its cells (80 m wide)
     /// (0..=65536; [`crate::render::cpu::light_volume`]). Default 1024: 16
     /// M photons over the fair-weather domain, the count the light was
-    /// fitted with; fewer give a noisier light (256 scored 0.6 points
+    /// fitted with; fewer give a noisier light (256 scored 0.5 points
     /// worse per pixel on the backlit view) for a faster build. 0 leaves
     /// the light volume out (the octaves alone carry multiple scattering).
     pub light_photons: u32,
