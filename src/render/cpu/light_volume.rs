@@ -49,12 +49,15 @@ pub const LIGHT_CELL_M: f32 = 80.0;
 /// over 6 times as long.
 pub const LIGHT_CELL_HEIGHT_M: f32 = 40.0;
 /// The most cells along the domain's side and along the band's height
-/// (96 layers: cells of 40 m up to a band 3.84 km deep).
-pub const LIGHT_CELLS_MAX: UVec3 = UVec3::new(192, 96, 192);
+/// (48 layers: cells of 40 m up to a band 1.92 km deep, taller beyond
+/// it). Kept at 48 when the layers went to 40 m: the largest grid is 1.8
+/// M cells, 177 MB on the GPU and a 64 MB copy of the sums per CPU
+/// thread, which deep convection's 12 km band reaches.
+pub const LIGHT_CELLS_MAX: UVec3 = UVec3::new(192, 48, 192);
 /// The photons' seed: the same clouds and sun give the same light.
 pub const LIGHT_SEED: u32 = 1;
 /// The sun's height under which no photon is traced (`LIGHT_SUN_MIN` in
-/// WGSL): a sun this low crosses a layer 20 cells sideways, and the
+/// WGSL): a sun this low crosses a layer 10 cells sideways, and the
 /// octaves carry its light.
 pub const LIGHT_SUN_MIN: f32 = 0.05;
 

@@ -101,6 +101,31 @@ fn the_photons_follow_the_columns() {
     assert_eq!(light_photons(&small, 64), 6400);
 }
 
+/// A cumulus band 1 km deep gets layers about 40 m tall under cells
+/// about 80 m wide (26 layers, not the 12 of cubic cells), and a band
+/// too deep for 48 such layers gets taller ones.
+#[test]
+fn the_layers_are_half_as_tall_as_the_cells_are_wide() {
+    let band = |bottom: f32, top: f32| DensityParams {
+        band_bottom_m: bottom,
+        band_top_m: top,
+        coverage: 0.75,
+        extinction_per_m: 0.04,
+        map_extent_m: 10_080.0,
+        detail_strength: 0.6,
+        detail_scale_m: 180.0,
+        fine_detail: true,
+    };
+    let g = LightVolumeGrid::new(&band(579.0, 1600.0));
+    assert_eq!(g.cells, UVec3::new(126, 26, 126));
+    assert!((g.cell_m.x - 80.0).abs() < 1e-3, "{}", g.cell_m);
+    assert!((g.cell_m.y - 39.27).abs() < 0.01, "{}", g.cell_m);
+    assert_eq!(g.bottom_m, 579.0);
+    let deep = LightVolumeGrid::new(&band(1000.0, 13_000.0));
+    assert_eq!(deep.cells.y, LIGHT_CELLS_MAX.y);
+    assert!((deep.cell_m.y - 250.0).abs() < 1e-3, "{}", deep.cell_m);
+}
+
 /// Around a 1 km cloud under a sun in the zenith: the light in its base
 /// flows down, away from the sun, and scatters down more than up (1.45
 /// times: what makes a backlit cloud's shaded side bright), while above

@@ -220,8 +220,9 @@ pub const AMBIENT_GAIN_ALONE: f32 = 4.37;
 /// ([`ambient_light`]), times this. Beside the diffusion the fit wanted
 /// 3.82 (the diffusion left the bases too dark); beside the transported
 /// sunlight, which reaches the bases through the clouds as it does in
-/// the path tracer, every fit with the gains at 0 or more put it at 0
-/// (docs/ground_truth, 2026-12-06; the references light the clouds from
+/// the path tracer, every fit with the gains at 0 or more put it at 0 or
+/// near it (0.011 with the 40 m layers, where 0 moves no view's error by
+/// more than 0.0002; docs/ground_truth, 2026-12-06; the references light the clouds from
 /// below only through the exported environment's lower half). The term
 /// is kept for a refit against references with a ground, but at 0 the
 /// renderers add nothing from it.
