@@ -1,7 +1,7 @@
 //! Cloud-map generation, P's spread, the light volume's steps (its
 //! transport per million photons), CPU rendering of a 320x240 frame, and the endless
-//! database's distances between its volumes (beside the doubles they
-//! were summed in until 2026-12-06).
+//! database's distances between its volumes (beside a plain sum in
+//! doubles, the baseline for their speed).
 //!
 //! `cargo bench --bench render`
 
@@ -13,8 +13,8 @@ use cumulus::render::cpu::light_transport::trace;
 use cumulus::render::cpu::light_volume::{
     LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons, sh_planes,
 };
-use cumulus::render::cpu::renderer::render_linear;
 use cumulus::render::cpu::sky::sun_direction;
+use cumulus::render::cpu::stills::render_linear;
 use cumulus::render::soft_field::{SPREAD_M, soft_field};
 use cumulus::scene::Scene;
 
@@ -73,8 +73,8 @@ fn render(c: &mut Criterion) {
     });
 }
 
-/// The distances as they were summed until 2026-12-06: every pair both
-/// ways round, in doubles, rows in parallel (the reference for [`distances`]' speed).
+/// The distances summed the plain way: every pair both ways round, in
+/// doubles, rows in parallel (the baseline for [`distances`]' speed).
 fn distances_in_doubles(volumes: &[Vec<u8>]) -> Vec<f64> {
     use rayon::prelude::*;
     let n = volumes.len();

@@ -1,6 +1,6 @@
 // The land's albedo: plain, or fields in rows with woods across them
 // (`[render.ground] land`), the twins of src/render/cpu/land.rs. Appended
-// after clouds.wgsl; the woods read the detail volume (group 0's
+// after CLOUDS (shaders.rs); the woods read the detail volume (group 0's
 // noise_tex). With LAND_FIELDS off the land is LAND_ALBEDO and nothing
 // here runs.
 

@@ -1,4 +1,4 @@
-// The analytic sky (appended after clouds.wgsl when the scene's
+// The analytic sky (appended after CLOUDS and land.wgsl when the scene's
 // `[render.atmosphere] model` is "analytic"): the twins of the analytic
 // arms of src/render/cpu/sky.rs. The same functions, reading the physical
 // tables, are in sky_physical.wgsl; a pass has one of the two.

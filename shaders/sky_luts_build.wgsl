@@ -1,4 +1,4 @@
-// The sky tables' four compute entry points, appended to sky_luts.wgsl
+// The sky tables' four compute entry points, appended to SKY_LUTS (sky_luts/)
 // (src/render/gpu/sky_luts_pass.rs builds them): one invocation per texel.
 
 const PI: f32 = 3.14159265358979;

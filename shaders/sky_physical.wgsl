@@ -1,4 +1,4 @@
-// The physical sky (appended after clouds.wgsl and sky_luts.wgsl when the
+// The physical sky (appended after CLOUDS and SKY_LUTS, shaders.rs, when the
 // scene's `[render.atmosphere] model` is "physical"): the twins of the
 // physical arms of src/render/cpu/sky.rs, reading Hillaire 2020's tables
 // that src/render/gpu/sky_luts_pass.rs builds (bindings 7 to 11 of group

@@ -5,9 +5,9 @@
 // grid the CPU precomputes. `cumulus bench` compares it with the cloud map;
 // `[render] renderer = "spheroids"` draws a scene with it. The CPU twin is
 // src/render/cpu/spheroids.rs. The sky, haze and tone map are the cloud
-// pass's own functions. Appended to clouds.wgsl and composite.wgsl.
+// pass's own functions. Appended to CLOUDS and COMPOSITE (shaders.rs).
 
-// Keep in sync with src/render/gpu/spheroids.rs: Spheroid.
+// Keep in sync with src/render/cpu/spheroids.rs: Spheroid.
 struct Spheroid {
     centre_radius: vec4f, // world centre (m), horizontal semi-axis (m)
     shape: vec4f,         // fill 0..1, vertical / horizontal axis, unused x2

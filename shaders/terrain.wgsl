@@ -1,4 +1,4 @@
-// The terrain pass (appended to clouds.wgsl), built only when the scene has
+// The terrain pass (appended to CLOUDS, shaders.rs), built only when the scene has
 // terrain: the heightfield rasterised as a grid mesh, tiled around the
 // camera to the longest ray, into an HDR colour target and a depth buffer.
 // It is lit by the sun through the clouds (their shadow) and the sky, and

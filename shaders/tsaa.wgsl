@@ -1,4 +1,4 @@
-// Temporal anti-aliasing of the cloud layer (appended to clouds.wgsl).
+// Temporal anti-aliasing of the cloud layer (appended to CLOUDS, shaders.rs).
 // Each frame's rays start at a Halton-jittered sub-pixel position and
 // dither; this pass reprojects the history to where the current pixel's
 // cloud was in the previous frame (through its transmittance-weighted

@@ -4,7 +4,7 @@
 // cross-dissolve) and marches the band. `[simulation] method = "endless"`
 // draws a scene with it. The CPU twin is src/render/cpu/volume.rs. The
 // sky, haze and tone map are the cloud pass's own functions. Appended to
-// clouds.wgsl and composite.wgsl.
+// CLOUDS and COMPOSITE (src/render/gpu/shaders.rs).
 
 // Keep in sync with src/render/cpu/volume.rs: VolumeParams.
 struct VolumeParams {

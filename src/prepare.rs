@@ -10,8 +10,8 @@ use glam::DVec2;
 
 use crate::render::cloud_map::CloudMap;
 use crate::render::cpu::density::Fields;
+use crate::render::cpu::frame::{Frame, Quality};
 use crate::render::cpu::light_volume::LightVolume;
-use crate::render::cpu::renderer::{Frame, Quality};
 use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::sky_luts::SkyLuts;
 use crate::render::cpu::spheroids::Spheroid;

@@ -58,7 +58,8 @@ fn warm_steps_allocate_nothing() {
     for parcels in [200, 4000] {
         let n = allocations_in_warm_steps(parcels);
         // A kept buffer may still grow now and then as the clouds change
-        // (amortised, not per step); before, every step made hundreds.
+        // (amortised, not per step); fresh buffers each step would be
+        // hundreds.
         assert!(
             n <= 4,
             "{parcels} parcels: {n} allocations in 20 warm steps"

@@ -12,10 +12,10 @@ use common::gpu;
 use cumulus::endless::{Database, Player};
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::Camera;
-use cumulus::render::cpu::renderer::to_srgb8;
 use cumulus::render::cpu::sky::sun_direction;
 use cumulus::render::cpu::sky::{Land, SkyModel};
 use cumulus::render::cpu::spheroids::{LightGrid, render_spheroids_srgb8};
+use cumulus::render::cpu::tone_map::to_srgb8;
 use cumulus::render::cpu::volume::render_volume;
 use cumulus::render::gpu::Headless;
 use cumulus::render::gpu::headless::TARGET_FORMAT;
@@ -360,7 +360,7 @@ fn the_spheroid_renderer_matches_its_cpu_twin() {
     );
     assert!(cloudy > (w * h / 20) as usize, "{cloudy} cloud pixels");
     // Measured on lavapipe: 0.08 levels, every channel within 3 (an
-    // aerial perspective applied the wrong way round on the CPU gave 1.4).
+    // aerial perspective applied the wrong way round on the CPU gives 1.4).
     assert!(mean < 0.4, "mean difference {mean} levels");
     assert!(within > 0.999, "{within} of channels within 3 levels");
 }

@@ -114,8 +114,8 @@ fn negative_radius_names_key() {
 }
 
 /// A value past a key's upper bound gets an error that states the whole
-/// range: these messages once said "expected > 0" of 1e6 (exposure) and
-/// 2e5 m (a parcel's radius), both above zero.
+/// range, not "expected > 0", which 1e6 (exposure) and 2e5 m (a parcel's
+/// radius) both are.
 #[test]
 fn out_of_range_errors_state_the_range() {
     assert_simulate_fails(
@@ -134,8 +134,8 @@ fn out_of_range_errors_state_the_range() {
         ("extinction_per_m", "1e-7", "1e-6..=10 1/m"),
         ("max_distance_m", "1e8", "1..=1e7 m"),
         ("haze_distance_m", "0.5", "1..=1e7 m"),
-        // Unchecked until 2026-12-05: a scale of 0 divided by zero in
-        // the density (NaN pixels in release builds).
+        // A scale of 0 would divide by zero in the density (NaN pixels
+        // in release builds).
         ("detail_scale_m", "0", "1..=1e5 m"),
         ("detail_strength", "2", "0..=1"),
     ] {
@@ -311,7 +311,7 @@ fn profile_prints_lcl_and_writes_one_row_per_level() {
 }
 
 /// Printing into a pipe whose reader is gone ends the run quietly, as Unix
-/// tools do (`println!` panicked: "failed printing to stdout: Broken pipe").
+/// tools do (`println!` would panic: "failed printing to stdout: Broken pipe").
 #[cfg(unix)]
 #[test]
 fn a_closed_pipe_on_stdout_ends_the_run_without_a_panic() {
@@ -332,7 +332,7 @@ fn a_closed_pipe_on_stdout_ends_the_run_without_a_panic() {
 }
 
 /// `--out /dev/stdout` with the output redirected into a log appends to
-/// the log: the temporary file renamed over it replaced the log and
+/// the log: a temporary file renamed over it would replace the log and
 /// what the run had printed into it.
 #[cfg(unix)]
 #[test]
@@ -447,7 +447,7 @@ fn sounding_flag_replaces_the_scene_atmosphere() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    // The environment now comes from the 3-level sounding: θ_v,env at the
+    // The environment comes from the 3-level sounding: θ_v,env at the
     // release height (50 m) is that of 20 °C at ~994 hPa with 15 °C dewpoint.
     let mut r = csv::Reader::from_path(&out).unwrap();
     let h = r.headers().unwrap().clone();
@@ -725,8 +725,9 @@ fn render_refuses_a_missing_folder_or_a_directory_before_simulating() {
     }
 }
 
-/// A successful run prints no "error" (the Wayland probe's XDG_RUNTIME_DIR
-/// complaint was printed twice) and names its backend once.
+/// A successful run prints no "error" (not even the Wayland probe's
+/// complaint about an unset XDG_RUNTIME_DIR, which the test provokes) and
+/// names its backend once.
 #[test]
 fn a_successful_render_prints_no_error_and_one_backend_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -914,8 +915,8 @@ fn odd_values_get_clear_errors() {
     );
 }
 
-/// SIGINT and SIGTERM remove the run's temporary file (it used to stay,
-/// up to 50 MB, as `.NAME.PID.tmp`); a later run into the same folder
+/// SIGINT and SIGTERM remove the run's temporary file (left, it would
+/// stay, up to 50 MB, as `.NAME.PID.tmp`); a later run into the same folder
 /// removes the ones that runs which are gone (SIGKILL) left.
 #[test]
 fn interrupted_runs_leave_no_temporary_file() {
@@ -1184,8 +1185,8 @@ fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
 
 /// Under a sun below the horizon the picture is exposed for the twilight
 /// (`render.auto_exposure`, on by default): the sky above the clouds is a
-/// dusk blue, not black. With it off, at the day's exposure, it is black
-/// (as every picture of a set sun was before 2026-12-05).
+/// dusk blue, not black. With it off, at the day's exposure, it is
+/// black.
 #[test]
 fn render_exposes_a_twilight_sky() {
     let dir = tempfile::tempdir().unwrap();

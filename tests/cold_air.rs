@@ -1,6 +1,6 @@
 //! Cold air: the default moisture excess (1 g/kg) is more than the whole
 //! saturation mixing ratio at -20 °C (about 0.8 g/kg), so an absolute excess
-//! made every parcel a fog droplet at its release height. Capped at the
+//! would make every parcel a fog droplet at its release height. Capped at the
 //! saturation of the parcel at the cloud base, no parcel may hold cloud
 //! below the surface air's LCL, while convection still makes cloud above.
 

@@ -1,14 +1,24 @@
-//! Numbers written in the README are what the code computes now: the
-//! cloud-field statistics table (`cumulus stats` at its defaults) is
-//! recomputed and compared at the precision it is printed with.
+//! Numbers written in the docs are what the code computes now: the
+//! cloud-field statistics table of docs/physics.md (`cumulus stats` at its
+//! defaults) is recomputed and compared at the precision it is printed
+//! with; the error tables of docs/renderer.md and docs/physics.md are the
+//! committed report CSVs, which are recomputed; the README's command table
+//! lists every flag.
 
 use cumulus::prepare::Prepared;
 use cumulus::report::field_stats::{column_field, field_stats};
 use cumulus::scene::Scene;
 
-/// The README row of `scene`: cloud fraction, D, exponent.
-fn readme_row(readme: &str, scene: &str) -> [f64; 3] {
-    let line = readme
+/// The text of a file of the crate, `path` relative to its root.
+fn doc(path: &str) -> String {
+    std::fs::read_to_string(format!("{}/{path}", env!("CARGO_MANIFEST_DIR")))
+        .unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// The statistics table's row of `scene` in `text`: cloud fraction, D,
+/// exponent.
+fn stats_row(text: &str, scene: &str) -> [f64; 3] {
+    let line = text
         .lines()
         .find(|l| l.starts_with(&format!("| `{scene}.toml` | 0.")))
         .unwrap_or_else(|| panic!("no statistics row for {scene}"));
@@ -23,9 +33,8 @@ fn readme_row(readme: &str, scene: &str) -> [f64; 3] {
 }
 
 #[test]
-fn readme_statistics_table_matches_the_code() {
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).expect("README");
+fn statistics_table_matches_the_code() {
+    let docs = ["README.md", "docs/physics.md"].map(|p| (p, doc(p)));
     for name in ["fair_weather", "bomex"] {
         let sc = Scene::load(std::path::Path::new(&format!("scenes/{name}.toml")))
             .expect("shipped scene");
@@ -42,13 +51,15 @@ fn readme_statistics_table_matches_the_code() {
             s.dimension.expect("D"),
             s.size_fit.expect("fit").slope,
         ];
-        let want = readme_row(&readme, name);
-        for (k, (g, w)) in got.iter().zip(want).enumerate() {
-            let step = if k == 0 { 5e-4 } else { 5e-3 };
-            assert!(
-                (g - w).abs() <= step + 1e-9,
-                "{name}: README says {w}, the code gives {g:.4} (column {k})"
-            );
+        for (path, text) in &docs {
+            let want = stats_row(text, name);
+            for (k, (g, w)) in got.iter().zip(want).enumerate() {
+                let step = if k == 0 { 5e-4 } else { 5e-3 };
+                assert!(
+                    (g - w).abs() <= step + 1e-9,
+                    "{name}: {path} says {w}, the code gives {g:.4} (column {k})"
+                );
+            }
         }
     }
 }
@@ -81,11 +92,10 @@ fn same_printed(got: f64, committed: f64, decimals: i32) -> bool {
     (got - committed).abs() <= 1.01 * 10f64.powi(-decimals)
 }
 
-/// The README table that follows the line containing `marker`: its rows'
-/// cells, bold marks removed.
-fn readme_table(marker: &str) -> Vec<Vec<String>> {
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).expect("README");
+/// The table of the doc at `path` that follows the line containing
+/// `marker`: its rows' cells, bold marks removed.
+fn doc_table(path: &str, marker: &str) -> Vec<Vec<String>> {
+    let readme = doc(path);
     let start = readme
         .find(marker)
         .unwrap_or_else(|| panic!("no `{marker}`"));
@@ -103,7 +113,7 @@ fn readme_table(marker: &str) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// A README cell is the committed value at the precision it is printed
+/// A table cell is the committed value at the precision it is printed
 /// with (`0.0082` for 0.008194; `12.1` for 12.0867; `0` for 0.0000).
 fn cell_matches(cell: &str, value: f64) -> bool {
     let decimals = cell.split('.').nth(1).map_or(0, |d| d.len()) as i32;
@@ -114,23 +124,23 @@ fn cell_matches(cell: &str, value: f64) -> bool {
 /// `docs/render_quality/render_quality.csv` is what the code measures now
 /// (the error columns; wall time depends on the machine), recomputed for
 /// two of its rows, the least and the default step count, against the
-/// full 2,048-step reference; and the README's table is that CSV.
+/// full 2,048-step reference; and docs/renderer.md's table is that CSV.
 #[test]
 fn render_quality_report_matches_the_code() {
     use cumulus::report::render_quality;
     let rows = csv_rows("docs/render_quality/render_quality.csv");
-    let table = readme_table("### Error against cost (rendering)");
-    assert!(table.len() >= 5, "README table: {table:?}");
+    let table = doc_table("docs/renderer.md", "### Error against cost (rendering)");
+    assert!(table.len() >= 5, "doc table: {table:?}");
     for cells in &table {
         let steps: f64 = cells[0].parse().expect("steps");
         let row = rows
             .iter()
             .find(|r| r["steps"] == steps)
-            .unwrap_or_else(|| panic!("README row of {steps} steps is not in the CSV"));
+            .unwrap_or_else(|| panic!("docs/renderer.md row of {steps} steps is not in the CSV"));
         for (k, col) in [(2, "mean_abs_error"), (3, "max_abs_error")] {
             assert!(
                 cell_matches(&cells[k], row[col]),
-                "README says {} for {col} at {} steps; the CSV has {}",
+                "docs/renderer.md says {} for {col} at {} steps; the CSV has {}",
                 cells[k],
                 row["steps"],
                 row[col]
@@ -162,14 +172,14 @@ fn render_quality_report_matches_the_code() {
 }
 
 /// `docs/convergence/convergence.csv` is what the code measures now (the
-/// error columns, all rows: the runs are short), and the README's table
+/// error columns, all rows: the runs are short), and docs/physics.md's table
 /// is that CSV.
 #[test]
 fn convergence_report_matches_the_code() {
     use cumulus::report::convergence;
     let rows = csv_rows("docs/convergence/convergence.csv");
-    let table = readme_table("## Error against run time (physics)");
-    assert!(table.len() >= 5, "README table: {table:?}");
+    let table = doc_table("docs/physics.md", "## Error against run time (physics)");
+    assert!(table.len() >= 5, "doc table: {table:?}");
     let columns = [
         "err_z_m",
         "err_w_mps",
@@ -184,11 +194,11 @@ fn convergence_report_matches_the_code() {
         let row = rows
             .iter()
             .find(|r| r["dt_s"] == dt)
-            .unwrap_or_else(|| panic!("README row dt = {dt} is not in the CSV"));
+            .unwrap_or_else(|| panic!("docs/physics.md row dt = {dt} is not in the CSV"));
         for (k, col) in columns.iter().enumerate() {
             assert!(
                 cell_matches(&cells[k + 2], row[*col]),
-                "README says {} for {col} at dt = {dt}; the CSV has {}",
+                "docs/physics.md says {} for {col} at dt = {dt}; the CSV has {}",
                 cells[k + 2],
                 row[*col]
             );

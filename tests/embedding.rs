@@ -10,11 +10,11 @@ use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::camera::View;
 use cumulus::render::cpu::land::flat_ground_albedo;
-use cumulus::render::cpu::renderer::{
-    flat_ground_shadow, pixel_dither, render_clouds_linear, to_srgb8,
-};
+use cumulus::render::cpu::renderer::{flat_ground_shadow, pixel_dither};
 use cumulus::render::cpu::sea::sea_reflection_change;
 use cumulus::render::cpu::sky::{background_radiance, sun_direction};
+use cumulus::render::cpu::stills::render_clouds_linear;
+use cumulus::render::cpu::tone_map::to_srgb8;
 use cumulus::render::cpu::waves::sea_waves_at;
 use cumulus::render::gpu::renderer::CLOUDS_ONLY_FORMAT;
 use cumulus::render::gpu::{CloudRenderer, GpuContext, textures};
@@ -235,8 +235,8 @@ fn every_depth_convention_hides_the_same_clouds() {
                 // with a 0.5 m near plane places a wall 3.5 km away only to
                 // ~1.5 m (ulp 6e-8 of 1 - d), which moves the clouds cut at
                 // it (with 0.1 m, ~7 m: 2.5e-3 of opacity); reading
-                // reversed depth as standard (the old code) hid all of
-                // them or none.
+                // reversed depth as standard would hide all of them or
+                // none.
                 let e = mean_abs(a, &walled, 3);
                 assert!(
                     e < 2e-3,
@@ -346,17 +346,14 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
     // but for a few ground pixels on the edges of the clouds' shadows,
     // whose rays through the detail noise the two twins round
     // differently (measured on lavapipe: 21 of 18,432 channels, at most
-    // 5 levels, once the land was lit by the sun with its full contrast
+    // 5 levels, with the land lit by the sun at its full contrast
     // between sun and shade). Over the sea, for a few more where the 12
-    // reflected rays, turned sideways by the waves, graze the mirrored
-    // clouds' edges (measured on lavapipe, 2026-12-04: 48-53 channels,
-    // all below the horizon, of either sign (25 brighter on the CPU, 28
-    // on the GPU), at most 10 levels; the mean difference 0.02 levels).
-    // Since the sea's resolved waves (2026-12-05) tilt each pixel's
-    // reflected rays, more of them graze those edges: 97-98 channels, at
-    // most 10 levels (the waves themselves agree: BOMEX with no clouds,
-    // 96x64, differs by at most 1 level; with clouds, the sea's rows
-    // differ by 0.18 levels on average, 0.15 before the waves).
+    // reflected rays, tilted and turned sideways by the waves, graze the
+    // mirrored clouds' edges (measured on lavapipe: 97-98 channels, all
+    // below the horizon, of either sign, at most 10 levels). The waves
+    // themselves agree: BOMEX with no clouds, 96x64, differs by at most
+    // 1 level; with clouds, the sea's rows differ by 0.18 levels on
+    // average.
     let share = if name == "bomex" { 0.0065 } else { 0.002 };
     assert!(
         off as f64 <= share * ours.len() as f64,
@@ -365,8 +362,8 @@ fn clouds_only_layer_composites(ctx: &GpuContext, name: &str) {
     // Over the sea, each pixel's 12 reflected rays take 4 to 16 steps
     // each across kilometres of band; where one of them grazes a cloud's edge
     // the twins can disagree on it, as the parity tests allow on single
-    // pixels (measured on lavapipe: one BOMEX pixel, 22 levels, with 6
-    // rays of 4 steps; 10 levels with 12 rays of 4 to 16, 2026-12-04).
+    // pixels (measured on lavapipe: one BOMEX pixel, 10 levels; 22
+    // with 6 rays of 4 steps).
     let allowed = if name == "bomex" { 64 } else { 8 };
     assert!(
         worst <= allowed,

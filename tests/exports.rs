@@ -9,9 +9,10 @@ use std::process::{Command, Output};
 
 use cumulus::prepare::Prepared;
 use cumulus::render::cpu::density::density_at;
-use cumulus::render::cpu::renderer::{to_srgb8, tone_map};
+use cumulus::render::cpu::density_grid::Grid;
+use cumulus::render::cpu::tone_map::{to_srgb8, tone_map};
 use cumulus::report::vdb::read_vdb;
-use cumulus::report::volume_export::{Grid, read_vol};
+use cumulus::report::volume_export::read_vol;
 use cumulus::scene::Scene;
 use glam::Vec3;
 

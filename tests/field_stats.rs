@@ -134,10 +134,10 @@ fn a_power_law_of_sizes_gives_its_exponent() {
 
 /// The shipped trade-cumulus and fair-weather scenes, seen from above as
 /// `cumulus stats` sees them, are natural cumulus fields by the measures
-/// of `FieldStats::departures_from_nature` (before the multi-scale cloud
-/// map and the spread P: D 0.99-1.02, exponents -0.24 and -1.13, one size
-/// of blob). A field of discs of many sizes is not (its D against the
-/// same range).
+/// of `FieldStats::departures_from_nature` (clouds drawn without the
+/// multi-scale cloud map and the spread P score D 0.99-1.02, exponents
+/// -0.24 and -1.13, one size of blob). A field of discs of many sizes is
+/// not (its D against the same range).
 #[test]
 fn shipped_scenes_seen_from_above_are_natural_cumulus_fields_and_discs_are_not() {
     use cumulus::prepare::Prepared;
@@ -198,7 +198,7 @@ fn shipped_scenes_seen_from_above_are_natural_cumulus_fields_and_discs_are_not()
 /// From high above, the shipped scenes do not repeat: over five domain
 /// widths around the simulated one, the cloud mask correlates with itself
 /// shifted by one domain width no more than shifted as far in other
-/// directions. Before the domain warp it was 0.50-0.57 against at most
+/// directions. Without the domain warp it is 0.50-0.57 against at most
 /// 0.04 (rows of the same clouds to the horizon).
 #[test]
 fn shipped_scenes_do_not_repeat_at_the_domain_period() {

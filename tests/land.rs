@@ -4,8 +4,9 @@
 //! the terrain's level ground is tinted the same way.
 
 use cumulus::prepare::Prepared;
-use cumulus::render::cpu::renderer::{march_ray, render_linear};
+use cumulus::render::cpu::renderer::march_ray;
 use cumulus::render::cpu::sky::{Land, Surface};
+use cumulus::render::cpu::stills::render_linear;
 use cumulus::scene::Scene;
 use glam::Vec3;
 
@@ -67,8 +68,9 @@ fn fields_vary_the_land_around_the_plain_lands_light() {
 
 #[test]
 fn a_ground_pixel_is_the_land_where_its_ray_meets_it() {
+    use cumulus::render::cpu::frame::Quality;
     use cumulus::render::cpu::land::{flat_ground_albedo, land_albedo};
-    use cumulus::render::cpu::renderer::{Quality, flat_ground_shadow};
+    use cumulus::render::cpu::renderer::flat_ground_shadow;
     use cumulus::render::cpu::sky::{LAND_ALBEDO, background_radiance, sun_direction};
     let mut sc = Scene::load(std::path::Path::new("scenes/fair_weather.toml")).expect("scene");
     sc.render.light_photons = 16;

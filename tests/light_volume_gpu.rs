@@ -42,9 +42,9 @@ fn mean_difference(a: &[[f32; 9]], b: &[[f32; 9]]) -> f64 {
 /// twins agree statistically. The GPU's coefficients differ from the
 /// CPU's (same seed) by at most [`NOISE_RATIO`] of what the CPU's differ
 /// from another seed of its own (the photons' noise; measured 0.24 on
-/// fair weather and 0.22 on BOMEX with 80 m layers, 0.24 and 0.21 with
-/// the 40 m layers of 2026-12-06: the paths stay the same photons', so
-/// a GPU drawing other random numbers, near 1, fails); the layers'
+/// fair weather and 0.21 on BOMEX with the 40 m layers, 0.24 and 0.22
+/// with 80 m ones: the paths stay the same photons', so a GPU drawing
+/// other random numbers, near 1, fails); the layers'
 /// totals (a whole layer's light, little noise) agree within
 /// [`LAYER_REL`]; and the planes the cloud pass samples are the GPU's
 /// sums through the phase's moments, within half-float precision.

@@ -126,8 +126,8 @@ fn hydrostatic_fill_matches_metpy_hypsometric_pressures() {
 
 /// The pseudo-adiabat is integrated level to level: its work grows with the
 /// pressure span (one RK4 step per `PSEUDO_STEP_PA` plus one per level),
-/// not with levels times span (it was re-integrated from the LCL for every
-/// level: about 1 s for 2,501 levels).
+/// not with levels times span (re-integrating from the LCL for every
+/// level takes about 1 s for 2,501 levels).
 #[test]
 fn pseudo_profile_work_is_linear_in_levels() {
     use cumulus::sim::lift::PSEUDO_STEP_PA;
@@ -198,8 +198,8 @@ fn reversible_adiabat_conserves_moist_entropy_to_12_km() {
 /// The simulator's own conserved pair (θ_l, q_t) against the same exact
 /// reversible reference: a parcel carrying the surface air's θ_l and q_t,
 /// placed at each reference pressure, is diagnosed by the simulator's
-/// saturation adjustment. The linearised θ_l it used before ran 7 K warm
-/// at 12 km (0.3 K off by 2.7 km).
+/// saturation adjustment. A linearised θ_l runs 7 K warm at 12 km (0.3 K
+/// off by 2.7 km).
 #[test]
 fn simulator_parcels_follow_the_exact_reversible_adiabat_to_12_km() {
     use cumulus::sim::config::PhysicsConfig;

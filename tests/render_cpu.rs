@@ -5,14 +5,14 @@ use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
 use cumulus::render::cpu::density::{
     BASE_RAMP, DensityParams, Fields, band_segment, density_at, footprint,
 };
+use cumulus::render::cpu::frame::{Frame, Quality};
 use cumulus::render::cpu::light_volume::LightVolume;
+use cumulus::render::cpu::lighting::ALBEDO;
 use cumulus::render::cpu::lighting::{
     SHADOW_STEP_SPAN_M, ShadowSteps, phase_dual, shadow_ray_length, sun_optical_depth,
     sun_transmittance,
 };
-use cumulus::render::cpu::renderer::{
-    ALBEDO, Frame, Quality, flat_ground_shadow, march_ray, render_linear, to_srgb8,
-};
+use cumulus::render::cpu::renderer::{flat_ground_shadow, march_ray};
 use cumulus::render::cpu::sea::{
     REFLECTION_MIN_ELEVATION, ReflectionLight, cross_slope, reflected_clouds, reflected_elevation,
     reflected_ray, sea_reflection,
@@ -20,6 +20,8 @@ use cumulus::render::cpu::sea::{
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, LAND_ALBEDO, SkyModel, background_radiance, sun_direction, sun_light_at,
 };
+use cumulus::render::cpu::stills::render_linear;
+use cumulus::render::cpu::tone_map::to_srgb8;
 use cumulus::render::cpu::waves::{flat_sea, sea_waves_at, slope_variance};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
@@ -83,10 +85,10 @@ fn density_is_zero_outside_the_band_and_where_coverage_is_zero() {
 
 /// No cloud ends in a wall where the parcels' spread coverage ends. At a
 /// coverage just over `footprint`'s cut (0.1 %), the mixed field's
-/// highest values made full-density cloud up to the cut, inside the
-/// simulated domain and in the warped sky around it (where the weather
-/// multiplies the cover by up to 1.4); now the density there is nearly
-/// 0, while a coverage of a few percent still makes dense cloud.
+/// highest values could make full-density cloud up to the cut, inside
+/// the simulated domain and in the warped sky around it (where the
+/// weather multiplies the cover by up to 1.4); the density there is
+/// nearly 0, while a coverage of a few percent still makes dense cloud.
 #[test]
 fn clouds_fade_out_before_the_coverage_cut() {
     let cm = cloud_map();
@@ -251,8 +253,8 @@ fn a_low_suns_shadow_ray_crosses_the_whole_band() {
     // From the band's bottom toward a sun 8° up, the light crosses 7.2 km
     // of a 1 km band. The shadow ray's optical depth must be that whole
     // path's, as a 100,000-point quadrature of the same density along it
-    // finds it: capped at 2 km (before 2026-12-03) it saw under half of
-    // it. A wide footprint keeps the detail noise smooth, so the 50-60
+    // finds it: a ray capped at 2 km would see under half of it. A wide
+    // footprint keeps the detail noise smooth, so the 50-60
     // steps' estimate is a quadrature too (tolerance 5 %).
     let cm = cloud_map();
     let p = ProjectedField::uniform(16, 16, [1.0, 1.0, 1.0]);
@@ -294,8 +296,8 @@ fn the_shadow_rays_offsets_average_to_the_exact_optical_depth() {
     // over offsets spread evenly in [0, 1) a step is sampled all along
     // it, so the mean optical depth is the ray's whole integral, as a
     // 200,000-point quadrature finds it, however fine the detail. At the
-    // steps' centres alone (the placement until 2026-12-04) the same 20
-    // steps miss the eroded detail's structure by several per cent.
+    // steps' centres alone the same 20 steps miss the eroded detail's
+    // structure by several per cent.
     let cm = cloud_map();
     let p = ProjectedField::uniform(16, 16, [1.0, 1.0, 1.0]);
     let f = Fields {
@@ -523,8 +525,8 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
 fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
     let cm = cloud_map();
     // Coverage 0.7: a sky with gaps between clouds. (At full coverage the
-    // map leaves almost none, and the pixels counted as sky were thin
-    // cloud over it, which the diffused sunlight now whitens.)
+    // map leaves almost none, and the pixels counted as sky would be thin
+    // cloud over it, which the diffused sunlight whitens.)
     let p = ProjectedField::uniform(32, 32, [0.7, 0.8, 1.0]);
     let mut fr = small_frame(&p, &cm);
     // Lit as a scene's frame is: with the light volume.
@@ -581,7 +583,7 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
 #[test]
 fn a_still_is_anti_aliased_like_the_gpus_frames() {
     use cumulus::prepare::Prepared;
-    use cumulus::render::cpu::renderer::{
+    use cumulus::render::cpu::stills::{
         render_converged, render_linear_offsets, render_still, supersampled_srgb8,
     };
     let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
@@ -616,15 +618,14 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
 /// `render.cpu_offsets` does for CPU pictures) takes the fixed dither's pattern out: at 16 steps,
 /// four offsets land at least a third closer to a 384-step image than one
 /// (measured 0.60 times as far), and one offset is `render_linear` exactly.
-/// (The test ran at 24 steps until the horizon's grazing rays took more
-/// steps, 2026-12-05: there the dither's part of the error became small,
-/// and the rest, clouds that fall between the coarse steps' fixed ends,
-/// is the same for every offset, so four offsets gained less than a
-/// third.)
+/// 16 steps, because at 24 the dither's part of the error is small (the
+/// horizon's grazing rays take more steps), and the rest, clouds that
+/// fall between the coarse steps' fixed ends, is the same for every
+/// offset, so four offsets gain less than a third there.
 #[test]
 fn averaged_offsets_approach_the_many_step_image() {
     use cumulus::prepare::Prepared;
-    use cumulus::render::cpu::renderer::render_linear_offsets;
+    use cumulus::render::cpu::stills::render_linear_offsets;
     let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
         .expect("shipped scene");
     sc.render.time_s = 1800.0;
@@ -736,8 +737,8 @@ fn the_sea_mirrors_the_clouds_above_it() {
 /// waves tilt the mirror and the Fresnel factor); 0.5° down, 3.4 km out,
 /// no wave is resolved (the footprint is 99 m across, by the cap on its anisotropy, and 394 m
 /// along)
-/// and the sea is smooth. Until 2026-12-05 the sea was a function of
-/// the ray's direction alone, a smooth gradient near and far.
+/// and the sea is smooth. A sea that is a function of the ray's
+/// direction alone, a smooth gradient near and far, fails here.
 #[test]
 fn the_sea_shows_its_waves_near_the_camera_and_not_far_off() {
     let cm = cloud_map();
@@ -817,12 +818,12 @@ fn the_waves_spread_the_reflected_rays_elevation() {
 /// sideways (to first order), against the exact reflection off a facet
 /// tilted toward or away from the viewer as well (by `α`, which sends
 /// the ray to `e`); the slopes across spread with Cox and Munk's deviation in one
-/// direction, `√(mss / 2)` (0.14 at 7 m/s). Until 2026-12-04 the
-/// reflected rays kept the view's azimuth, and a mirrored cloud's streak
-/// had the cloud's sharp sides all the way down; `2 s sin(mirror)`,
-/// without the facet's tilt toward the viewer, turned the steep rays
-/// near the horizon a fifth as far as they go (0.6° for 2.8°), and
-/// `2 s sin((mirror + e) / 2)` erred by up to 4 % at the steepest.
+/// direction, `√(mss / 2)` (0.14 at 7 m/s). Rays that kept the view's
+/// azimuth would draw a mirrored cloud's streak with the cloud's sharp
+/// sides all the way down; `2 s sin(mirror)`, without the facet's tilt
+/// toward the viewer, turns the steep rays near the horizon a fifth as
+/// far as they go (0.6° for 2.8°), and `2 s sin((mirror + e) / 2)` errs
+/// by up to 4 % at the steepest.
 #[test]
 fn the_waves_turn_the_reflected_rays_sideways() {
     let n = 20_000;
@@ -871,8 +872,8 @@ fn the_waves_turn_the_reflected_rays_sideways() {
 /// A rough sea mirrors clouds its flat mirror ray misses: looking down
 /// 0.3°, the mirror ray would reach the band 95 km out, beyond the 40 km
 /// the march goes; the waves' steeper rays meet the cloud layer, and it
-/// dims the mirrored sky. (One mirror ray, before the waves' spread, left
-/// these pixels bare.)
+/// dims the mirrored sky. (One mirror ray, without the waves' spread,
+/// leaves these pixels bare.)
 #[test]
 fn a_rough_sea_mirrors_clouds_the_mirror_ray_misses() {
     let cm = cloud_map();
@@ -913,7 +914,7 @@ fn a_rough_sea_mirrors_clouds_the_mirror_ray_misses() {
 /// (docs/ground_truth/ground_shadow.py; its deepest-shade bin in
 /// `ground_shadow_bins.csv`, τ toward the sun 8-16): the land's
 /// irradiance over π within 12 % of the path tracer's for a sun 60° and
-/// 30° high. The clear sky alone gave 0.33 and 0.27 against 0.66 and 0.40.
+/// 30° high. The clear sky alone gives 0.33 and 0.27 against 0.66 and 0.40.
 #[test]
 fn the_shade_under_clouds_gets_the_path_tracers_light() {
     use cumulus::prepare::Prepared;
@@ -959,10 +960,10 @@ fn the_shade_under_clouds_gets_the_path_tracers_light() {
 /// A reflected ray's march hides as much of the sky as its clouds do:
 /// over many dithers its mean opacity is within 8 % of a 4000-step
 /// march's along the same rays. Rays rising at 10° through the 1 km band
-/// cross 5.8 km of it; four fixed steps, 1.4 km each, landed in a cloud
-/// or missed it, and their mean opacity was 0.82 of the fine march's
-/// (1.00 with `reflection_step_count`'s 16; on BOMEX's sea the mirrored
-/// clouds showed as sparse bright grain, too dark).
+/// cross 5.8 km of it; four fixed steps, 1.4 km each, land in a cloud
+/// or miss it, and their mean opacity is 0.82 of the fine march's (1.00
+/// with `reflection_step_count`'s 16; on BOMEX's sea the mirrored clouds
+/// show as sparse bright grain, too dark).
 #[test]
 fn a_reflected_rays_march_does_not_step_over_clouds() {
     use cumulus::render::cpu::sea::reflection_step_count;

@@ -9,8 +9,8 @@ use common::gpu;
 use cumulus::prepare::Prepared;
 use cumulus::render::cpu::land;
 use cumulus::render::cpu::lighting::{SHADOW_RAY_M, forward_step_factor, shadow_step_count};
-use cumulus::render::cpu::renderer::still_srgb8;
 use cumulus::render::cpu::sky::SkyModel;
+use cumulus::render::cpu::stills::still_srgb8;
 use cumulus::render::gpu::renderer::{
     PASS_CLOUDS, PASS_COMPOSITE, PASS_LIGHT_VOLUME, PASS_TERRAIN, PASS_TSAA,
 };
@@ -25,8 +25,8 @@ fn scene(name: &str) -> Scene {
     // minute to build on lavapipe, and no test here measures the light.
     // 64, not 16: the GPU's photons follow the CPU's random numbers, but
     // a few part ways by rounding, and with 16 a column (cells 40 m
-    // tall) the view from the ground had 0.744 of its channels equal,
-    // under `PARITY_EQUAL`.
+    // tall) the view from the ground measured 0.744 of its channels
+    // equal, under `PARITY_EQUAL`.
     sc.render.light_photons = 64;
     sc
 }
@@ -57,8 +57,7 @@ const PARITY_MEAN: f64 = 0.002;
 /// renderers can disagree on whether to refine it (f32 against f64), and
 /// that one pixel changes by up to half the range (measured on lavapipe:
 /// at most 0.23 on one pixel of 6,144; 0.44 on one pixel of the 96x64
-/// strong-inversion view since the exact θ_l moved its clouds' edges by a
-/// few metres). The clouds' shadows on the flat ground flip the same way
+/// strong-inversion view). The clouds' shadows on the flat ground flip the same way
 /// at a shadow's edge: 0.63 on one channel of the 96x64 view from above
 /// the layer, where the ground shows between the clouds (a pixel in full
 /// sun on one and in full shade on the other, since the land is lit by
@@ -69,8 +68,8 @@ const PARITY_MAX: f64 = 0.7;
 /// (measured: at most 3 of 18,432).
 const PARITY_OUTLIERS: f64 = 0.002;
 /// The same over terrain (measured on lavapipe: 137 of 18,432 on the
-/// evening view, 0.74 %, once the clouds' shadows on the ground read the
-/// detail noise; the mean stayed 0.0015).
+/// evening view, 0.74 %, where the clouds' shadows on the ground read the
+/// detail noise; the mean 0.0015).
 const PARITY_OUTLIERS_TERRAIN: f64 = 0.012;
 
 /// GPU against CPU, the least fraction of channels with the very same
@@ -79,7 +78,7 @@ const PARITY_OUTLIERS_TERRAIN: f64 = 0.012;
 /// lavapipe: 0.79-0.91 over the parity views (the least from the
 /// ground, under the light volume's cloud bases); with the GPU's dither
 /// turned off (and the CPU's on) 0.62-0.66, which the mean, 0.0013-0.0016,
-/// did not catch.
+/// does not catch.
 const PARITY_EQUAL: f64 = 0.75;
 
 /// [`parity`] at 96x64 with the default bounds, the size most views use.
@@ -646,8 +645,8 @@ fn tsaa_smooths_the_seas_reflection() {
     );
     eprintln!("the sea against the oracle: 1 frame {one:.5}, 32 frames {many:.5}");
     // Measured on lavapipe: 0.0112 -> 0.0023 (0.21; 0.0094 -> 0.0040 with
-    // 6 rays of 4 steps until 2026-12-04); drawn after TSAA, the sea
-    // stayed at 0.0091 (0.99).
+    // 6 reflected rays of 4 steps); drawn after TSAA, the sea would stay
+    // at 0.0091 (0.99).
     assert!(many < 0.7 * one, "1 frame {one}, 32 frames {many}");
 }
 

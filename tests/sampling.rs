@@ -53,13 +53,12 @@ fn converged_frames_have_the_references_high_pass_energy() {
             hp.one_frame_ratio()
         );
         // The error of one frame is unstructured: its largest positive
-        // correlation at a lag measured 0.084 and 0.057 (2026-12-05; the
-        // absolute value, before, 0.070 and 0.074, until the blue
-        // noise's negative ring, -0.16 at a lag of (5, 4), was most of
-        // what was left at the horizon once its rays took more steps). This guards against patterned error in the image,
-        // such as banding; it does not tell the dithers apart (the
-        // interleaved gradient noise used before gave 0.070 and 0.075 in
-        // the absolute measure). The dither's own pattern is tested in
+        // correlation at a lag measured 0.084 and 0.057 (negative ones are
+        // left out: the blue noise's own ring, -0.16 at a lag of (5, 4),
+        // is most of what is left toward the horizon). This guards
+        // against patterned error in the image, such as banding; it does
+        // not tell the dithers apart (an interleaved gradient noise
+        // passes it too). The dither's own pattern is tested in
         // `render::sampling`.
         assert!(
             hp.one_frame_pattern < 0.095,

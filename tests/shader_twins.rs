@@ -1,11 +1,12 @@
 //! The WGSL and its CPU twins, checked by machine with naga (no GPU
 //! needed): every WGSL function is the twin of a Rust function of the same
-//! name under `src/render/`, or on the short GPU-only list below with the
-//! reason; every WGSL constant equals its Rust twin; the `Frame` uniform's
+//! name in the Rust module its file mirrors (`shaders/density.wgsl` and
+//! `src/render/cpu/density.rs`, see `MIRRORS`), or on the short GPU-only
+//! list below with the reason; no WGSL file is over 500 lines; every WGSL constant equals its Rust twin; the `Frame` uniform's
 //! members sit at the offsets of `FrameUniforms`' fields, `Spheroid`'s at
 //! those of the spheroid renderer's `Spheroid`, and the sky tables' `SkyParams` and
 //! `SkyView` at those of `SkyParamsUniforms` and `SkyViewUniforms`. The
-//! sources are `all_variants()`, which includes `shaders/sky_luts.wgsl`.
+//! sources are `all_variants()`, which include `shaders/sky_luts/`.
 
 use std::collections::BTreeSet;
 use std::mem::offset_of;
@@ -13,8 +14,8 @@ use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
 use cumulus::render::cpu::{
-    density, glare, land, light_transport, light_volume, lighting, renderer, sea, sky, sky_luts,
-    waves,
+    density, frame, glare, land, light_transport, light_volume, lighting, renderer, sea, sky,
+    sky_luts, waves,
 };
 use cumulus::render::gpu::light_volume_pass::{self, LightVolumeGridUniforms};
 use cumulus::render::gpu::shaders::all_variants;
@@ -140,8 +141,8 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("NOISE_MAX_LOD", density::NOISE_MAX_LOD as f64),
         ("NOISE_SIZE", cumulus::render::noise_volume::SIZE as f64),
         ("BLUE_NOISE_SIZE", cumulus::render::sampling::SIZE as f64),
-        ("ALBEDO", renderer::ALBEDO as f64),
-        ("MIN_TRANSMITTANCE", renderer::MIN_TRANSMITTANCE as f64),
+        ("ALBEDO", lighting::ALBEDO as f64),
+        ("MIN_TRANSMITTANCE", frame::MIN_TRANSMITTANCE as f64),
         ("SUN_DISK_COS", sky::SUN_DISK_COS as f64),
         ("WATER_F0", sky::WATER_F0 as f64),
         ("SHADOW_RAY_M", lighting::SHADOW_RAY_M as f64),
@@ -169,17 +170,17 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             "MULTIPLE_ISOTROPIC_GAIN_ALONE",
             lighting::MULTIPLE_ISOTROPIC_GAIN_ALONE as f64,
         ),
-        ("AMBIENT_GAIN_ALONE", renderer::AMBIENT_GAIN_ALONE as f64),
+        ("AMBIENT_GAIN_ALONE", lighting::AMBIENT_GAIN_ALONE as f64),
         (
             "GROUND_LIGHT_GAIN_ALONE",
-            renderer::GROUND_LIGHT_GAIN_ALONE as f64,
+            lighting::GROUND_LIGHT_GAIN_ALONE as f64,
         ),
         ("DIFFUSE_DEPTH_M", lighting::DIFFUSE_DEPTH_M as f64),
-        ("AMBIENT_GAIN", renderer::AMBIENT_GAIN as f64),
-        ("GROUND_LIGHT_GAIN", renderer::GROUND_LIGHT_GAIN as f64),
+        ("AMBIENT_GAIN", lighting::AMBIENT_GAIN as f64),
+        ("GROUND_LIGHT_GAIN", lighting::GROUND_LIGHT_GAIN as f64),
         ("GROUND_SHADOW_STEPS", renderer::GROUND_SHADOW_STEPS as f64),
         ("RAY_DEPTH", cumulus::render::camera::RAY_DEPTH as f64),
-        // shaders/sky_luts.wgsl (PI above is shared).
+        // shaders/sky_luts/atmosphere.wgsl (PI above is shared).
         ("GOLDEN_ANGLE", sky_luts::GOLDEN_ANGLE as f64),
         ("TRANSMITTANCE_WIDTH", sky_luts::TRANSMITTANCE_SIZE.0 as f64),
         (
@@ -444,4 +445,149 @@ fn sky_uniform_members_match_their_rust_blocks() {
     same_layout("SkyParams", &rust, size_of::<SkyParamsUniforms>());
     let rust = offsets!(SkyViewUniforms: camera_radius_km, sun_cos_zenith);
     same_layout("SkyView", &rust, size_of::<SkyViewUniforms>());
+}
+
+/// Each WGSL file and the Rust files whose functions it mirrors, one to one
+/// by name. A pass's own file (its entry points, bindings and glue) may
+/// mirror none, and says so with an empty list.
+const MIRRORS: &[(&str, &[&str])] = &[
+    ("frame.wgsl", &["src/render/cpu/frame.rs"]),
+    ("camera.wgsl", &["src/render/camera.rs"]),
+    ("density.wgsl", &["src/render/cpu/density.rs"]),
+    ("lighting.wgsl", &["src/render/cpu/lighting.rs"]),
+    ("sky.wgsl", &["src/render/cpu/sky.rs"]),
+    ("sky_analytic.wgsl", &["src/render/cpu/sky.rs"]),
+    ("sky_physical.wgsl", &["src/render/cpu/sky.rs"]),
+    ("waves.wgsl", &["src/render/cpu/waves.rs"]),
+    ("sea.wgsl", &["src/render/cpu/sea.rs"]),
+    ("tone_map.wgsl", &["src/render/cpu/tone_map.rs"]),
+    ("composite.wgsl", &["src/render/cpu/tone_map.rs"]),
+    ("glare.wgsl", &["src/render/cpu/glare.rs"]),
+    ("renderer.wgsl", &["src/render/cpu/renderer.rs"]),
+    ("land.wgsl", &["src/render/cpu/land.rs"]),
+    ("light_volume.wgsl", &["src/render/cpu/light_volume.rs"]),
+    (
+        "light_transport.wgsl",
+        &["src/render/cpu/light_transport.rs"],
+    ),
+    (
+        "light_volume_build.wgsl",
+        &["src/render/cpu/light_volume.rs"],
+    ),
+    ("spheroids.wgsl", &["src/render/cpu/spheroids.rs"]),
+    ("volume.wgsl", &["src/render/cpu/volume.rs"]),
+    // `terrain_hides` is each composite variant's, written in shaders.rs.
+    (
+        "standalone.wgsl",
+        &["src/render/cpu/standalone.rs", "src/render/gpu/shaders.rs"],
+    ),
+    // The terrain pass: the heightfield's functions (render::terrain), its
+    // albedo (land) and its shading, which the CPU does where it marches
+    // (terrain_radiance).
+    (
+        "terrain.wgsl",
+        &[
+            "src/render/terrain.rs",
+            "src/render/cpu/land.rs",
+            "src/render/cpu/renderer.rs",
+        ],
+    ),
+    (
+        "sky_luts/atmosphere.wgsl",
+        &["src/render/cpu/sky_luts/atmosphere.rs"],
+    ),
+    (
+        "sky_luts/tables.wgsl",
+        &["src/render/cpu/sky_luts/tables.rs"],
+    ),
+    (
+        "sky_luts/lookups.wgsl",
+        &["src/render/cpu/sky_luts/lookups.rs"],
+    ),
+    ("sky_luts_build.wgsl", &[]),
+    ("tsaa.wgsl", &[]),
+];
+
+/// Every `.wgsl` file under `shaders/`, relative to it.
+fn wgsl_files() -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).expect("shaders/") {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else if p.extension().is_some_and(|e| e == "wgsl") {
+                let rel = p.strip_prefix(root).expect("under shaders/");
+                out.push(rel.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut out = Vec::new();
+    walk(&root, &root, &mut out);
+    out.sort();
+    out
+}
+
+/// The names of the functions a WGSL text defines at module scope, less
+/// its entry points (a `fn` right after `@compute`, `@fragment` or
+/// `@vertex`, or on the same line).
+fn wgsl_fn_names(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut after_stage = false;
+    for l in text.lines() {
+        let t = l.trim();
+        let stage = ["@compute", "@fragment", "@vertex"]
+            .iter()
+            .any(|a| t.starts_with(a));
+        if let Some(rest) = l.strip_prefix("fn ")
+            && !after_stage
+        {
+            out.push(rest.split('(').next().unwrap_or("").trim().to_string());
+        }
+        if stage && !t.contains("fn ") {
+            after_stage = true;
+        } else if !t.starts_with('@') {
+            after_stage = false;
+        }
+    }
+    out
+}
+
+#[test]
+fn each_wgsl_file_mirrors_its_rust_module() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let gpu_only: BTreeSet<&str> = GPU_ONLY.iter().map(|(n, _)| *n).collect();
+    let mut wrong = Vec::new();
+    for file in wgsl_files() {
+        let Some((_, rust_files)) = MIRRORS.iter().find(|(f, _)| *f == file) else {
+            wrong.push(format!(
+                "shaders/{file}: not in MIRRORS (name its Rust twin)"
+            ));
+            continue;
+        };
+        let text = std::fs::read_to_string(root.join("shaders").join(&file)).expect("read");
+        let lines = text.lines().count();
+        if lines > 500 {
+            wrong.push(format!("shaders/{file}: {lines} lines (at most 500)"));
+        }
+        let rust: String = rust_files
+            .iter()
+            .map(|f| std::fs::read_to_string(root.join(f)).expect("a mirrored Rust file"))
+            .collect();
+        for name in wgsl_fn_names(&text) {
+            if !gpu_only.contains(name.as_str()) && !has_rust_fn(&rust, &name) {
+                wrong.push(format!(
+                    "shaders/{file}: fn {name} has no twin in {rust_files:?}"
+                ));
+            }
+        }
+    }
+    for (file, _) in MIRRORS {
+        if !wgsl_files().iter().any(|f| f == file) {
+            wrong.push(format!(
+                "MIRRORS names shaders/{file}, which does not exist"
+            ));
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
 }

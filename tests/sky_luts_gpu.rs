@@ -1,4 +1,4 @@
-//! The sky tables built on the GPU (`SkyLutsPass`, `shaders/sky_luts.wgsl`)
+//! The sky tables built on the GPU (`SkyLutsPass`, `shaders/sky_luts_build.wgsl`)
 //! against their CPU twins (`render::cpu::sky_luts`), and the rebuilds the
 //! pass skips. Runs on whatever adapter exists (lavapipe in CI). Without one
 //! each test prints `SKIPPED: no GPU adapter` and passes, unless

@@ -211,3 +211,79 @@ fn the_codemap_names_every_module() {
         missing.join("\n")
     );
 }
+
+/// Whether `line` holds a calendar date, `YYYY-MM-DD`.
+fn has_date(line: &str) -> bool {
+    let b = line.as_bytes();
+    b.windows(10).any(|w| {
+        let digits = |r: std::ops::Range<usize>| w[r].iter().all(u8::is_ascii_digit);
+        digits(0..4) && w[4] == b'-' && digits(5..7) && w[7] == b'-' && digits(8..10)
+    })
+}
+
+/// Every file under `dir` (relative to the crate) whose name ends in one
+/// of `exts`.
+fn files_under(dir: &str, exts: &[&str]) -> Vec<PathBuf> {
+    fn walk(p: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
+        let Ok(entries) = std::fs::read_dir(p) else {
+            return;
+        };
+        for e in entries {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                walk(&p, exts, out);
+            } else if exts.iter().any(|x| p.to_string_lossy().ends_with(x)) {
+                out.push(p);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join(dir),
+        exts,
+        &mut out,
+    );
+    out.sort();
+    out
+}
+
+/// History lives in CHANGELOG.md and the git log. The README and every
+/// comment in the code and shaders say what is true now, with no date;
+/// the other docs may put a date beside a figure only as the day it was
+/// measured ("measured YYYY-MM-DD" on the same line).
+#[test]
+fn no_dated_narrative_outside_the_changelog() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut bad = Vec::new();
+    let mut check = |path: &Path, allow_measured: bool, comments_only: bool| {
+        let text = std::fs::read_to_string(path).expect("read");
+        for (n, line) in text.lines().enumerate() {
+            let t = line.trim_start();
+            if comments_only && !t.starts_with("//") {
+                continue;
+            }
+            if has_date(line) && !(allow_measured && line.contains("measured")) {
+                bad.push(format!("{}:{}: {}", path.display(), n + 1, line.trim()));
+            }
+        }
+    };
+    check(&root.join("README.md"), false, false);
+    check(&root.join("ARCHITECTURE.md"), true, false);
+    for f in files_under("docs", &[".md"]) {
+        check(&f, true, false);
+    }
+    for f in files_under("shaders", &[".md"]) {
+        check(&f, true, false);
+    }
+    for dir in ["src", "tests", "benches", "examples", "shaders"] {
+        for f in files_under(dir, &[".rs", ".wgsl"]) {
+            check(&f, false, true);
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "dated lines (history belongs in CHANGELOG.md; a doc may say \"measured DATE\" \
+         beside a figure):\n{}",
+        bad.join("\n")
+    );
+}

@@ -6,8 +6,8 @@
 #
 #   docs/ground_truth/gain_parts.sh OUTDIR
 #
-# Writes OUTDIR/cumulus_{zero,mf,mi,di,fl,am,gr}. Edits the two source files
-# that hold the gains in place and restores them on exit (also on error
+# Writes OUTDIR/cumulus_{zero,mf,mi,di,fl,am,gr}. Edits the source file
+# that holds the gains (lighting.rs) in place and restores it on exit (also on error
 # or Ctrl-C), then rebuilds the shipped binary. About a minute a build.
 # Honours CARGO_TARGET_DIR (builds there, so a binary another script is
 # running from target/ is left alone).
@@ -16,12 +16,10 @@ cd "$(dirname "$0")/../.."
 out=${1:?usage: gain_parts.sh OUTDIR}
 mkdir -p "$out"
 L=src/render/cpu/lighting.rs
-R=src/render/cpu/renderer.rs
 keep=$(mktemp -d)
-cp "$L" "$R" "$keep/"
+cp "$L" "$keep/"
 restore() {
   cp "$keep/lighting.rs" "$L"
-  cp "$keep/renderer.rs" "$R"
   rm -rf "$keep"
 }
 trap restore EXIT
@@ -29,13 +27,12 @@ for v in zero mf mi di fl am gr; do
   mf=0.0 mi=0.0 di=0.0 fl=0.0 am=0.0 gr=0.0
   case $v in mf) mf=1.0 ;; mi) mi=1.0 ;; di) di=1.0 ;; fl) fl=1.0 ;; am) am=1.0 ;; gr) gr=1.0 ;; esac
   cp "$keep/lighting.rs" "$L"
-  cp "$keep/renderer.rs" "$R"
   sed -i "s/^pub const MULTIPLE_GAIN: f32 = .*/pub const MULTIPLE_GAIN: f32 = $mf;/;
           s/^pub const MULTIPLE_ISOTROPIC_GAIN: f32 = .*/pub const MULTIPLE_ISOTROPIC_GAIN: f32 = $mi;/;
           s/^pub const DIFFUSE_GAIN: f32 = .*/pub const DIFFUSE_GAIN: f32 = $di;/;
           s/^pub const FLUENCE_GAIN: f32 = .*/pub const FLUENCE_GAIN: f32 = $fl;/" "$L"
   sed -i "s/^pub const AMBIENT_GAIN: f32 = .*/pub const AMBIENT_GAIN: f32 = $am;/;
-          s/^pub const GROUND_LIGHT_GAIN: f32 = .*/pub const GROUND_LIGHT_GAIN: f32 = $gr;/" "$R"
+          s/^pub const GROUND_LIGHT_GAIN: f32 = .*/pub const GROUND_LIGHT_GAIN: f32 = $gr;/" "$L"
   cargo build --release --bin cumulus
   cp "${CARGO_TARGET_DIR:-target}/release/cumulus" "$out/cumulus_$v"
 done

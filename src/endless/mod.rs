@@ -1,7 +1,7 @@
 //! Endless animation from precomputed volumes (Iwasaki, Nishino & Dobashi
 //! 2011, papers 000 and 002): the scene's parcels are simulated ahead and
 //! the density the cloud-map renderer marches is sampled into a database
-//! of volumes `interval_s` apart (`report::volume_export::sample`, the
+//! of volumes `interval_s` apart (`render::cpu::density_grid::sample`, the
 //! volume export's own sampler); the distance between every two volumes
 //! is measured; at run time [`Player`] plays an endless sequence, jumping
 //! from volume `k` to a volume like `k + 1` (the Video Textures idea) and
@@ -41,9 +41,9 @@ pub enum Source {
 }
 
 use crate::prepare::Prepared;
+use crate::render::cpu::density_grid::{Grid, sample};
 use crate::render::cpu::volume::{VolumeParams, VolumeStack};
 use crate::render::gpu::GpuSettings;
-use crate::report::volume_export::{Grid, sample};
 use crate::scene::{EndlessConfig, RenderSettings, Scene, SceneError};
 use crate::sim::Band;
 

@@ -1,7 +1,7 @@
 //! The cloud map CM: a seeded, tileable 2D texture of multi-scale
 //! fractal noise, the horizontal pattern the clouds take where the parcels
 //! are (the cloud-map paper's section 3.2.1 uses Worley cells times
-//! Perlin noise; one cell size made every cloud the same size).
+//! Perlin noise; one cell size makes every cloud the same size).
 //!
 //! Channel 0 is Perlin fBm over `octaves` octaves from `cells` features
 //! across the map, each octave `roughness` times the last: level sets of
@@ -25,7 +25,7 @@ use std::sync::{Arc, Mutex};
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
 
-use super::noise_volume::NoiseVolume;
+use super::noise_volume::{NoiseVolume, rank_uniform};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the cloud map (scene table `[render.cloud_map]`).
@@ -143,21 +143,6 @@ fn torus(u: f64, v: f64, features: f64) -> [f64; 4] {
     let r = features / std::f64::consts::TAU;
     let (a, b) = (u * std::f64::consts::TAU, v * std::f64::consts::TAU);
     [r * a.cos(), r * a.sin(), r * b.cos(), r * b.sin()]
-}
-
-/// The rank of each value among all, mapped to `(0, 1)`: a field with a
-/// uniform histogram, so a threshold at `1 - f` leaves the fraction `f`
-/// of the map above it. Ties are broken by index (deterministic).
-pub(super) fn rank_uniform(values: impl Iterator<Item = f64>) -> Vec<f64> {
-    let v: Vec<f64> = values.collect();
-    let mut order: Vec<usize> = (0..v.len()).collect();
-    order.sort_by(|&a, &b| v[a].total_cmp(&v[b]).then(a.cmp(&b)));
-    let mut out = vec![0.0; v.len()];
-    let n = v.len().max(1) as f64;
-    for (rank, &i) in order.iter().enumerate() {
-        out[i] = (rank as f64 + 0.5) / n;
-    }
-    out
 }
 
 impl CloudMap {

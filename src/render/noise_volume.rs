@@ -19,8 +19,6 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::cloud_map::rank_uniform;
-
 /// Texels per side.
 pub const SIZE: usize = 64;
 
@@ -286,6 +284,21 @@ impl NoiseVolume {
         }
         lerp2(a, self.trilinear(k as usize + 1, q), f)
     }
+}
+
+/// The rank of each value among all, mapped to `(0, 1)`: a field with a
+/// uniform histogram, so a threshold at `1 - f` leaves the fraction `f`
+/// of the map above it. Ties are broken by index (deterministic).
+pub(super) fn rank_uniform(values: impl Iterator<Item = f64>) -> Vec<f64> {
+    let v: Vec<f64> = values.collect();
+    let mut order: Vec<usize> = (0..v.len()).collect();
+    order.sort_by(|&a, &b| v[a].total_cmp(&v[b]).then(a.cmp(&b)));
+    let mut out = vec![0.0; v.len()];
+    let n = v.len().max(1) as f64;
+    for (rank, &i) in order.iter().enumerate() {
+        out[i] = (rank as f64 + 0.5) / n;
+    }
+    out
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 //! 1993) of a 64x64 torus: every prefix of the ordering is an evenly spread
 //! point set, so the offsets of neighbouring pixels differ as much as they
 //! can and their error has no low frequencies. A fixed per-pixel pattern
-//! with structure (the interleaved gradient noise used before) left a 2x2
+//! with structure (an interleaved gradient noise, say) leaves a 2x2
 //! checker and moire on cloud surfaces; this pattern's error looks like
 //! fine grain, which TSAA's neighbourhood filter and history remove.
 //!
@@ -280,8 +280,8 @@ mod tests {
     }
 
     /// The dither has no structure beyond its nearest neighbours, unlike
-    /// the interleaved gradient noise it replaced, whose values repeat
-    /// along lines (what drew the checker and moire on cloud surfaces).
+    /// an interleaved gradient noise, whose values repeat along lines
+    /// (they draw a checker and moire on cloud surfaces).
     #[test]
     fn the_dither_has_no_pattern_at_any_lag() {
         let blue = pattern(tile());

@@ -2,7 +2,7 @@
 //! of the clouds' merging scale.
 //!
 //! P gives each condensed parcel a hard disc of its radius, so a density
-//! that cut clouds at P's edge made every cloud a disc of one parcel's
+//! that cut clouds at P's edge would make every cloud a disc of one parcel's
 //! size. Spread out, the coverage of a lone parcel stays low and only the
 //! highest points of the multi-scale cloud map rise through it (a few
 //! small clouds), while the coverages of neighbouring parcels add up and
@@ -22,7 +22,7 @@ use crate::sim::ProjectedField;
 /// Standard deviation of the spread, m: about a cumulus parcel's radius
 /// (250-400 m in the shipped scenes), so the coverages of parcels a few
 /// radii apart add up into one cloud's. Chosen with `cumulus stats`: at
-/// 150 m the clouds kept the parcels' disc outlines (area-perimeter
+/// 150 m the clouds keep the parcels' disc outlines (area-perimeter
 /// dimension 1.16-1.18), at 400 m the map's outlines show (1.30-1.32).
 pub const SPREAD_M: f32 = 400.0;
 
@@ -69,9 +69,9 @@ pub fn soft_field(p: &ProjectedField, sigma_m: f32, extent_m: f32) -> ProjectedF
 /// around the period is wrapped onto it instead, one weight per texel
 /// (the tails of every period summed): on an even axis its two end taps
 /// are the same texel, each with half its weight. Cut to `n - 1` taps,
-/// as until 2026-12-05, an even axis left the texel opposite each source
-/// with no share of it (domains under about six spreads, 2.4 km at the
-/// shipped 400 m; none of the shipped scenes).
+/// an even axis would leave the texel opposite each source with no share
+/// of it (domains under about six spreads, 2.4 km at the shipped 400 m;
+/// none of the shipped scenes).
 fn gaussian_kernel(sigma_m: f32, texel_m: f32, n: usize) -> Vec<f32> {
     let s = (sigma_m / texel_m).max(1e-3);
     let gauss = |x: f32| (-0.5 * (x / s).powi(2)).exp();
@@ -205,10 +205,10 @@ mod tests {
         }
     }
 
-    /// The parallel blur gives the serial loop's result bit for bit (the
-    /// loop it replaced: one texel at a time, its taps in kernel order,
-    /// wrapped with `rem_euclid`), along both axes, with kernels as long
-    /// as the field allows.
+    /// The parallel blur gives a serial loop's result bit for bit (one
+    /// texel at a time, its taps in kernel order, wrapped with
+    /// `rem_euclid`), along both axes, with kernels as long as the field
+    /// allows.
     #[test]
     fn the_parallel_blur_is_the_serial_sum_bit_for_bit() {
         fn serial(src: &[[f32; 3]], w: usize, h: usize, k: &[f32], along_x: bool) -> Vec<[f32; 3]> {
@@ -247,8 +247,8 @@ mod tests {
 
     /// A spread wider than the field wraps around it: a lone texel's
     /// coverage on an axis of 8 and of 7 texels is the Gaussian summed
-    /// over every period, at every texel. Cut to 7 taps, the even axis
-    /// gave the texel opposite the source nothing.
+    /// over every period, at every texel (cut to 7 taps, the even axis
+    /// would give the texel opposite the source nothing).
     #[test]
     fn a_spread_wider_than_the_field_wraps_around_it() {
         for n in [8_usize, 7] {

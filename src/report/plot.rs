@@ -147,9 +147,8 @@ const LABEL_PX: f64 = 18.0;
 /// straight above and below) whose box stays inside
 /// the plot and overlaps neither an earlier label's box nor another
 /// ring; if none is, the first that stays inside the plot (else the
-/// right-hand place). Two defaults that sit
-/// at nearly the same cost and error had their labels drawn over each
-/// other.
+/// right-hand place), so that two defaults that sit at nearly the same
+/// cost and error do not have their labels drawn over each other.
 fn label_offsets(rings: &[(f64, f64, usize)]) -> Vec<(i32, i32)> {
     const GAP: f64 = 14.0;
     const RING: f64 = 10.0;
@@ -419,8 +418,8 @@ mod tests {
 
     #[test]
     fn a_short_log_axis_is_labelled_below_its_first_decade() {
-        // The render-quality plot's time axis, 0.17 to 4.7 s: it had
-        // labels at 1, 2, 3 and 4 only.
+        // The render-quality plot's time axis, 0.17 to 4.7 s: labelled
+        // below 1 too, not at 1, 2, 3 and 4 only.
         let (bold, light) = log_ticks(0.17, 4.7);
         assert_eq!(bold, vec![0.2, 0.5, 1.0, 2.0]);
         assert!(light.contains(&0.3) && light.contains(&4.0) && !light.contains(&0.1));
@@ -429,7 +428,7 @@ mod tests {
         assert_eq!(bold.len(), 7);
         assert!(log_ticks(0.0, 1.0).0.is_empty());
         // Under a decade (a flat curve, 1.0 to 4.2 s): every multiple is
-        // labelled; the coverage plot's frame-time axis had one label.
+        // labelled (else the coverage plot's frame-time axis gets one label).
         let (bold, light) = log_ticks(980.0, 4200.0);
         assert_eq!(bold, vec![1000.0, 2000.0, 3000.0, 4000.0]);
         assert!(light.is_empty());
@@ -437,9 +436,9 @@ mod tests {
 
     #[test]
     fn ring_labels_do_not_overlap() {
-        // The H200's render-error plot: "octaves 3" and "shadow_steps 20"
-        // ringed 18 px apart on one level; both labels went right of
-        // their rings, one over the other.
+        // As on the H200's render-error plot: "octaves 3" and
+        // "shadow_steps 20" ringed 18 px apart on one level, whose labels
+        // must not both go right of their rings, one over the other.
         let rings = [(430.0, 340.0, 11), (448.0, 338.0, 17), (300.0, 340.0, 10)];
         let offsets = label_offsets(&rings);
         let boxes: Vec<[f64; 4]> = rings

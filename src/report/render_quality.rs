@@ -9,10 +9,11 @@ use glam::Vec3;
 use super::ReportError;
 use super::plot::{Series, loglog_png};
 use crate::io::write_atomically;
-use crate::render::cpu::renderer::{
-    Frame, render_clouds_linear, render_converged, render_linear, render_linear_offsets,
-    to_srgb8_exact, tone_map,
+use crate::render::cpu::frame::Frame;
+use crate::render::cpu::stills::{
+    render_clouds_linear, render_converged, render_linear, render_linear_offsets,
 };
+use crate::render::cpu::tone_map::{to_srgb8_exact, tone_map};
 use crate::render::sampling::JITTER_CYCLE;
 
 /// Step counts measured.
@@ -183,9 +184,8 @@ pub fn highpass_energy(rgb8: &[u8], mask: &[bool], width: u32, height: u32) -> f
 /// Negative correlations are left out: blue noise is anti-correlated
 /// with itself a few pixels away by design (its tile down to -0.09 at
 /// these lags), and an error made of nothing but its grain shows that
-/// ring (measured 2026-12-05 at -0.16, a lag of (5, 4), once the
-/// horizon's grazing rays took more steps and the rest of the error fell
-/// away).
+/// ring (measured at -0.16, a lag of (5, 4), on a view whose grazing
+/// rays take enough steps that the grain is all the error left).
 pub fn pattern_correlation(
     image: &[u8],
     reference: &[u8],

@@ -37,8 +37,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::volume_export::{Grid, VolumeError};
+use super::volume_export::VolumeError;
 use crate::io::write_atomically;
+use crate::render::cpu::density_grid::Grid;
 
 /// OpenVDB's magic number, "` BDV`" (written as a little-endian `i64`).
 pub const MAGIC: i64 = 0x5644_4220;

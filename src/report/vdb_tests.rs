@@ -265,7 +265,7 @@ fn node_values_are_zipped_or_kept_raw_and_read_back() {
         }
     }
     let bytes = vdb_bytes(&g, &values, "sigma_t").expect("bytes");
-    // The noise leaf went raw: its 2048 bytes behind -2048.
+    // The noise leaf is stored raw: its 2048 bytes behind -2048.
     let raw_mark = (-2048_i64).to_le_bytes();
     assert!(bytes.windows(8).any(|w| w == raw_mark), "no raw chunk");
     let leaves = values.chunks(512).count();

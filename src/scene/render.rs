@@ -8,7 +8,7 @@ use crate::render::camera::Camera;
 use crate::render::cloud_map::CloudMapConfig;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::exposure::auto_exposure_factor;
-use crate::render::cpu::renderer::Quality;
+use crate::render::cpu::frame::Quality;
 use crate::render::cpu::sky::{AtmosphereConfig, GroundConfig};
 use crate::render::gpu::terrain_pass::TERRAIN_REACH_MAX;
 use crate::render::gpu::{GpuSettings, TsaaSettings};
@@ -68,14 +68,15 @@ pub struct RenderSettings {
     /// turn it off, since the exported grid (9.7 m cells) cannot hold it.
     pub fine_detail: bool,
     /// Primary march steps (1..=4096). Default 48 (chosen from
-    /// `cumulus render --quality-report`, see README).
+    /// `cumulus render --quality-report`; docs/renderer.md, "Error against
+    /// cost (rendering)").
     pub steps: u32,
     /// Shadow march steps toward the sun (0..=64; 0 = off). Default 20:
     /// fewer, longer steps miss small wisps and leak light (against the
     /// path tracer on a 1024-cell grid, the backlit view's single
-    /// scattering is 12.4 % off per pixel at 20, 9.5 % at 32, 9.0 % at
-    /// 64, and 35 % at 12 with the samples at their steps' centres;
-    /// docs/ground_truth, 2026-12-04).
+    /// scattering measured 12.4 % off per pixel at 20, 9.5 % at 32, 9.0 %
+    /// at 64, and 35 % at 12 with the samples at their steps' centres;
+    /// docs/ground_truth/single_scattering.sh).
     pub shadow_steps: u32,
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
     /// (the light was fitted to the path tracer with 3). 0 turns multiple
@@ -119,10 +120,10 @@ pub struct RenderSettings {
     /// its golden-ratio dither offset, which moves the samples and the
     /// shadow samples within their steps; `render_still`). 1: one march
     /// through each pixel's centre, which shows the dither's fine grain
-    /// at 48 steps (1..=64). Default 8 (4 until 2026-12-05: near clouds'
-    /// edges showed the dither's checker, more so with the fine billows;
-    /// 8 takes it out at 2.1 times the time, 30 s against 14 s for
-    /// view_below_base at 640x480 on 2 cores). The endless volumes' pictures
+    /// at 48 steps (1..=64). Default 8: at 4, near clouds' edges show the
+    /// dither's checker, more so with the fine billows, and 8 takes it out
+    /// at 2.1 times the time (30 s against 14 s for view_below_base at
+    /// 640x480 on 2 cores). The endless volumes' pictures
     /// average the dither offsets through pixel centres (no TSAA on their
     /// GPU pass); the spheroids' take one march.
     pub cpu_offsets: u32,
@@ -205,7 +206,7 @@ impl RenderSettings {
                 f(r.camera_position_m[1]),
             ),
             // Beyond this the f32 ray maths loses the cloud band (a camera
-            // at 1e9 m drew a black picture).
+            // at 1e9 m draws a black picture).
             Check::new(
                 "render.camera_position_m",
                 r.camera_position_m[0].abs() <= CAMERA_REACH_M

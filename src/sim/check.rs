@@ -35,7 +35,7 @@ impl Check {
     /// A check that `value` is finite and in `lo..=hi`. A value read
     /// into an `f32` field (and widened) is held against the bounds as
     /// `f32`s: `1e-6` written for a bound of `1e-6` reads as the f32
-    /// nearest it, 9.99999997e-7, which the f64 bound refused.
+    /// nearest it, 9.99999997e-7, which the f64 bound would refuse.
     pub fn range(
         key: impl Into<Cow<'static, str>>,
         value: f64,
@@ -75,7 +75,8 @@ mod tests {
 
     #[test]
     fn an_f32_value_written_as_its_bound_is_within_it() {
-        // `render.extinction_per_m = 1e-6` was refused as "is 0.000001,
+        // `render.extinction_per_m = 1e-6` is read into an f32 just under
+        // the f64 bound, and must not be refused as "is 0.000001,
         // expected 1e-6..=10".
         for (v, lo, hi) in [(1e-6_f32, 1e-6, 10.0), (0.1, 0.1, 1.0), (0.3, 0.0, 0.3)] {
             let c = Check::range("k", f64::from(v), lo, hi, "");
@@ -90,8 +91,8 @@ mod tests {
 
     #[test]
     fn values_read_as_f32_are_reported_as_written() {
-        // A scene's camera_pitch_deg is an f32; the error once said
-        // "is -89.9000015258789".
+        // A scene's camera_pitch_deg is an f32; the error says -89.9,
+        // not "is -89.9000015258789".
         let c = Check::range(
             "render.camera_pitch_deg",
             f64::from(-89.9_f32),

@@ -121,9 +121,9 @@ impl PhysicsConfig {
                 "1e-3..=100",
             ),
             // The SPH kernel's reach must fit in half the domain. Said of
-            // the parcels' radius, with the two other keys' values: the
-            // error once named `smoothing_radii` (a default the user
-            // never wrote) when `radius_m` or `domain_size_m` was set.
+            // the parcels' radius, with the two other keys' values, not of
+            // `smoothing_radii`, a default the user seldom writes: a user
+            // who meets it has set `radius_m` or `domain_size_m`.
             Check::new(
                 "physics.radius_m",
                 !p.sph.enabled
@@ -209,7 +209,8 @@ impl PhysicsConfig {
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsConfig {
     /// Frame time step, s. Domain 1e-3..=600. Default 5 (chosen from
-    /// `cumulus convergence`, see README).
+    /// `cumulus convergence`; docs/physics.md, "Error against run time
+    /// (physics)").
     pub dt_s: f64,
     /// Number of parcels. Domain 0..=200000. Default 12 (as in the paper).
     pub parcels: usize,

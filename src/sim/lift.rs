@@ -50,7 +50,7 @@ pub fn moist_air_kappa(qv: f64) -> f64 {
 /// constant and heat capacity, meets the dewpoint of the conserved mixing
 /// ratio. This is the problem Romps (2017) solves in closed form (MetPy's
 /// `lcl` since 1.6); here by bisection to 1e-6 Pa. With the dry `κ` the LCL
-/// of hot, humid air was up to 17 m too low. Saturated (or supersaturated)
+/// of hot, humid air is up to 17 m too low. Saturated (or supersaturated)
 /// air is at its LCL.
 pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
     let Some(td0) = dewpoint(qv, p_pa) else {

@@ -18,8 +18,8 @@ use super::thermo::{
 /// the parametric profile's bound on `surface_relative_humidity` (1.2).
 /// Air in nature is supersaturated by well under a percent, and a
 /// radiosonde's humidity errs by a few; beyond a fifth the row is a
-/// mistake (until 2026-12-06: 150 %, or a dewpoint 10 K above the
-/// temperature, some 180 % at 25 °C).
+/// mistake (a bound of 150 %, or of a dewpoint 10 K above the
+/// temperature, some 180 % at 25 °C, would let such rows through).
 pub const RH_MAX: f64 = 1.2;
 
 /// How far a dewpoint may lie above its temperature whatever the

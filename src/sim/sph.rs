@@ -20,7 +20,7 @@ use super::kernels::{Kernel, Poly6, Spiky, Viscosity};
 /// Above this many active parcels the solver runs the SPH passes on all
 /// cores (rayon); below it the thread hand-off costs more than it saves.
 /// The crossover is measured by `cargo bench --bench physics -- sph_crossover`
-/// (README, Speed).
+/// (docs/physics.md, "Speed").
 pub const PARALLEL_THRESHOLD: usize = 2048;
 
 /// Parameters of one SPH evaluation.

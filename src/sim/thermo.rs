@@ -10,8 +10,8 @@
 //! `θ_l` is the exact one of Emanuel (1994, Eq. 4.5.15), a function of the
 //! reversible moist entropy and `q_t` alone, so a saturated parcel that
 //! carries its condensate follows the exact reversible adiabat to any
-//! height (the linearised `T = Π θ_l + L_v q_c / c_p` used before ran 7 K
-//! too warm at 12 km in a tropical column). Unsaturated air rises on the
+//! height (the linearised `T = Π θ_l + L_v q_c / c_p` runs 7 K too warm
+//! at 12 km in a tropical column). Unsaturated air rises on the
 //! adiabat of moist air, `T ∝ p^χ` with `χ = (R_d + r_t R_v)/(c_pd + r_t
 //! c_pv)`, the adiabat the LCL (Romps 2017) is computed on (up to the
 //! fifth digit of R_v: Ambaum's here, 461.5 J/(kg K) in `lift`).

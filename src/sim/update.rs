@@ -1,5 +1,5 @@
 //! The per-parcel update of one sub-step ([`advance_parcel`]), in this
-//! order (README, "The model"):
+//! order (docs/physics.md, "The model, and the choices made"):
 //!
 //! 0. SPH accelerations between released parcels (if on).
 //! 1. Half kick: `w += Δt/2 (B/(1+γ) + a_sph,z)` with quadratic drag

@@ -9,8 +9,9 @@ use anyhow::{Context, Result, bail};
 use glam::Vec3;
 
 use cumulus::prepare::Prepared;
+use cumulus::render::cpu::density_grid::{self, Grid};
 use cumulus::report::vdb;
-use cumulus::report::volume_export::{self, Grid, Sidecar};
+use cumulus::report::volume_export::{self, Sidecar};
 
 use crate::{
     check_output_file, guard_output_file, load_scene, progress_bar, with_overrides, write_exr,
@@ -115,7 +116,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let frame = prepared.density_frame(r, r.quality());
     guard_output_file(&a.out);
     guard_output_file(&sidecar_path);
-    let values = volume_export::sample(&frame, &grid);
+    let values = density_grid::sample(&frame, &grid);
     if vdb {
         vdb::write_vdb(&a.out, &grid, &values, volume_export::QUANTITY)?;
     } else {

@@ -268,7 +268,7 @@ fn guard_output_dir(dir: &Path) {
 }
 
 /// Makes the output folder `dir` (and its parents), an existing file
-/// there refused by name (the OS said only "File exists"), and guards it
+/// there refused by name (the OS says only "File exists"), and guards it
 /// ([`guard_output_dir`]).
 fn create_output_folder(dir: &Path) -> Result<()> {
     if dir.exists() && !dir.is_dir() {

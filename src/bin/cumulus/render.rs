@@ -109,7 +109,8 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::renderer::{Quality, add_sun_glare, render_still};
+    use cumulus::render::cpu::frame::Quality;
+    use cumulus::render::cpu::stills::{add_sun_glare, render_still};
     use cumulus::report::render_quality;
 
     let flags = [
@@ -310,7 +311,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
 /// [`cumulus::render::gpu::context::LLVMPIPE_LOOP_ITERATIONS`]):
 /// measured on fair weather at 64x48, 512 x 20 and 1024 x 10 are 0.10
 /// levels from the CPU, 768 x 20 0.28, 1024 x 20 1.3, 512 x 64 2.1
-/// (README, "Lavapipe at 1024 steps or more"). The default is 48 x 20.
+/// (docs/gpu.md, "Lavapipe at 1024 steps or more"). The default is 48 x 20.
 const LAVAPIPE_MARCH_LOAD_MAX: u32 = 10_240;
 
 /// `render` on the GPU: `--frames` frames (TSAA converges), the last one
@@ -570,7 +571,7 @@ fn write_linear(
         return write_exr(out, r.width, r.height, rgb);
     }
     let exposure = r.quality().exposure;
-    let bytes = cumulus::render::cpu::renderer::to_srgb8(linear, exposure);
+    let bytes = cumulus::render::cpu::tone_map::to_srgb8(linear, exposure);
     write_rgb8(out, r.width, r.height, bytes)
 }
 

@@ -1,5 +1,5 @@
 //! Cloud density inside the height band, from P and the cloud map
-//! (README, "The renderer").
+//! (docs/renderer.md, "Density").
 
 use glam::Vec3;
 
@@ -80,9 +80,10 @@ pub const DETAIL_TILE: f32 = BASE_CELLS as f32;
 /// The billows channel is read at this many times the base channel's
 /// frequency (features of 0.62 to 0.15 `detail_scale_m`): the golden
 /// ratio, so the two channels' tiles never line up and their sum does not
-/// repeat over the clouds. With [`BASE_WEIGHT`] chosen with `cumulus
-/// stats` on BOMEX and fair weather (area-perimeter D 1.37 and 1.37; 2.13
-/// and weight 0.6 gave 1.43 and 1.40, rougher than real fields' 1.35).
+/// repeat over the clouds. Chosen with [`BASE_WEIGHT`] by `cumulus
+/// stats` on BOMEX and fair weather: area-perimeter D 1.37 on both, near
+/// real fields' 1.35, where 2.13 with a base weight of 0.6 measures 1.43
+/// and 1.40.
 pub const BILLOW_FREQUENCY: f32 = 1.618;
 
 /// Weight of the base channel in the detail noise (the billows have the
@@ -207,8 +208,8 @@ pub fn detail_noise(
 /// The fine billows' frequency over the base channel's (the billows
 /// channel read over tiles of 180 m at the default 180 m scale, texels
 /// of 2.8 m): the small turrets of a cloud seen from a few hundred
-/// metres. At 6.7 they were finer than the march's steps near the
-/// camera (25 m from under the base) and showed as grain.
+/// metres. At 6.7 they are finer than the march's steps near the camera
+/// (25 m from under the base) and show as grain.
 pub const FINE_FREQUENCY: f32 = 4.0;
 /// The fine billows' weight in the detail noise, near the camera.
 pub const FINE_WEIGHT: f32 = 0.16;
@@ -216,7 +217,7 @@ pub const FINE_WEIGHT: f32 = 0.16;
 /// weight; none from twice it (6 m: clouds within about 1.5-2.5 km at
 /// 640x480), so the far clouds, the field statistics and the volume
 /// export's grid (read at a footprint of its cell, 9.8 m at 1024 cells
-/// over 10 km) are as they were without them.
+/// over 10 km) are the same as without them.
 pub const FINE_SHARP_M: f32 = 3.0;
 
 /// The weight of the fine billows at a footprint of `footprint_m`:
@@ -350,20 +351,20 @@ pub const WARP_SCALE_M: f32 = 9000.0;
 /// Amplitude of each of the warp's three sines per axis, m (in metres, not
 /// domain widths, so the warp's stretch stays under ~50 % whatever the
 /// domain's size). Chosen with `cumulus stats`' repetition measure on the
-/// 10 km domains: 1,500 m over 7-12 km left the period's correlation at
-/// 0.08-0.2 (rows still there); 1,700 m over 9 km hid it until the
-/// erosion grew with height ([`EROSION_BASE`]), which left the map more
-/// say (BOMEX 0.057 at the period against 0.054 elsewhere); 2,000 m hides
-/// it again (0.038 against 0.044; fair weather 0.029 against 0.051).
+/// 10 km domains: at 2,000 m the correlation at the domain's period is
+/// no higher than at other lags (BOMEX 0.038 against 0.044, fair weather
+/// 0.029 against 0.051); 1,500 m leaves it at 0.08-0.2, rows to the
+/// horizon, and 1,700 m is marginal with the erosion that grows with
+/// height ([`EROSION_BASE`], which gives the map more say).
 pub const WARP_AMPLITUDE_M: f32 = 2000.0;
 
 /// The displacement (map units, for a map of `extent_m`) of the lookups
 /// into P and the cloud map at world `(x, z)`: a sum of sines of incommensurate wavelengths, smooth
 /// (it stretches the clouds by up to ~40 % locally, in directions that
-/// change across the sky) and not periodic. The
-/// simulated domain tiles the sky; without the warp the same clouds came
-/// back every domain width in rows to the horizon, and with it the copy
-/// one domain width away is looked up up to a domain width elsewhere.
+/// change across the sky) and not periodic. The simulated domain tiles
+/// the sky; without the warp the same clouds would come back every domain
+/// width in rows to the horizon, and with it the copy one domain width
+/// away is looked up up to a domain width elsewhere.
 #[inline]
 pub fn domain_warp(x: f32, z: f32, extent_m: f32) -> (f32, f32) {
     let (a, b) = (x / WARP_SCALE_M, z / WARP_SCALE_M);
@@ -385,7 +386,7 @@ pub fn domain_warp(x: f32, z: f32, extent_m: f32) -> (f32, f32) {
 /// simulated copy of the domain (its corners are 0.71 from the centre) is
 /// drawn where its parcels are, as P says (the per-parcel spheroids and an
 /// application's own use of the parcels agree with the picture), and the
-/// copies around it are warped. A slower ramp (to 2.0 or 2.5) left the
+/// copies around it are warped. A slower ramp (to 2.0 or 2.5) leaves the
 /// period visible in `cumulus stats`' repetition measure.
 pub const WARP_RAMP: (f32, f32) = (0.72, 1.3);
 
@@ -480,11 +481,12 @@ pub const P_COVERAGE_MIN: f32 = 1e-3;
 /// field's highest value ([`field_max`]), reaching it at [`WEATHER_MAX`]
 /// times [`P_COVERAGE_MIN`], the highest presence at `footprint`'s cut.
 /// The mixed field exceeds 1 over a few percent of the sky, so a
-/// threshold that stopped at 1 made cloud at any coverage up to the cut
-/// and sliced it there in vertical walls (docs/view_below_base.png until
-/// 2026-12-05). The fringe is about 140 m wide beside the soft field's
+/// threshold that stopped at 1 would make cloud at any coverage up to the
+/// cut and slice it there in vertical walls, seen from below as straight
+/// cut edges. The fringe is about 140 m wide beside the soft field's
 /// Gaussian; what it takes away (specks a kilometre from any condensed
-/// parcel) is measured in the README ("What still looks wrong").
+/// parcel) is under 0.01 of the cloud fraction (docs/renderer.md, "What
+/// still looks wrong").
 pub const FRINGE_PRESENCE: f32 = 0.005;
 
 /// The cumulus field's threshold at normalised height `eta` under a local
@@ -495,13 +497,13 @@ pub const FRINGE_PRESENCE: f32 = 0.005;
 /// points make are flat-based and domed, taller where the field is
 /// higher. Over the top fifth ([`TOP_ROUNDING`]) it climbs on to the
 /// field's highest value, which it reaches at the top: the mixed field
-/// exceeds 1 in a cloud's core, and a threshold that stopped at 1 left
-/// the core cut off flat at the local top, a smooth surface that read as
-/// a ruler-straight lid at the horizon (docs/view_horizon.png until
-/// 2026-12-05). Now the noise rounds every top off below it. Where the
-/// `presence` (P's spread coverage times the weather) falls under
-/// [`FRINGE_PRESENCE`] it climbs the same way, so clouds end before P
-/// does, not at its edge; over it the threshold is the same, bit for bit.
+/// exceeds 1 in a cloud's core, and a threshold that stopped at 1 would
+/// cut the core off flat at the local top, a smooth surface that reads as
+/// a ruler-straight lid at the horizon; this way the noise rounds every
+/// top off below it. Where the `presence` (P's spread coverage times the
+/// weather) falls under [`FRINGE_PRESENCE`] it climbs the same way, so
+/// clouds end before P does, not at its edge; over it the threshold is
+/// the same, bit for bit.
 #[inline]
 pub fn cumulus_threshold(eta: f32, top: f32, cover: f32, presence: f32, s: f32) -> f32 {
     let t = eta / top;
@@ -520,7 +522,7 @@ pub const DETAIL_CONTRAST: f32 = 1.23;
 
 /// Share of the detail strength that erodes a cloud at its base; it grows
 /// linearly to the full strength at the local top. Chosen with `cumulus
-/// stats` and the high-flight view: eroding evenly (1.0) perforated the
+/// stats` and the high-flight view: eroding evenly (1.0) perforates the
 /// clouds seen from above with 50-150 m holes through the whole column;
 /// 0.6 keeps their lower bodies whole under billowed tops (BOMEX and fair
 /// weather D 1.34 and 1.33, size exponents -1.97 and -1.94).
@@ -549,7 +551,7 @@ pub fn cloud_field(m: f32, n: f32, s: f32) -> f32 {
 /// simulated domain, the warped lookup (in metres) outside it, so the
 /// copies of the domain around it do not repeat the detail either (the
 /// volume's tile, 4 · 180 m, nearly divides a 10 km domain, and without
-/// the warp `cumulus stats` saw the period again).
+/// the warp `cumulus stats` sees the period again).
 #[inline]
 pub fn noise_point(p: Vec3, lookup: (f32, f32, f32), extent_m: f32) -> Vec3 {
     let (u, v, k) = lookup;

@@ -134,9 +134,9 @@ fn cloud_tops_are_rounded_not_cut() {
 /// Clouds end before the parcels' spread coverage does. `footprint`
 /// cuts the density off where P's coverage falls to 1e-3; with a
 /// threshold that went to 1 as the cover went to 0, the mixed field's
-/// values over 1 (map and noise both high) kept their full density up to
-/// that contour and ended in a vertical wall there (the profile 1 at `s`
-/// 0.3 and 0.6). Now the densest field fades out before it, grows back
+/// values over 1 (map and noise both high) would keep their full density
+/// up to that contour and end in a vertical wall there (the profile 1 at
+/// `s` 0.3 and 0.6). The densest field fades out before it, grows back
 /// smoothly over the fringe, and from [`FRINGE_PRESENCE`] on the
 /// threshold is the one without a fringe, for any scene coverage.
 #[test]

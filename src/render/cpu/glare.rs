@@ -2,7 +2,7 @@
 //! eye scatter from the bright sun disk onto the image around it, so the
 //! sun is a glowing disk instead of a few clipped pixels (`render.sun_glare`,
 //! default 1; 0 leaves it out). Each function is the twin of the WGSL
-//! function of the same name in `shaders/composite.wgsl`.
+//! function of the same name in `shaders/glare.wgsl`.
 //!
 //! The spread is the small-angle term of the CIE's glare spread function
 //! for the human eye (CIE 146:2002, after Vos and van den Berg): the

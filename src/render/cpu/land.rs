@@ -24,7 +24,7 @@
 use glam::Vec3;
 
 use super::density::{NOISE_MAX_LOD, gained, lod_of};
-use super::renderer::Frame;
+use super::frame::Frame;
 use super::sky::LAND_ALBEDO;
 use crate::render::noise_volume::{NoiseVolume, SIZE as NOISE_SIZE};
 

@@ -12,8 +12,9 @@
 //! unit sun irradiance, as nine coefficients, without the diffusion
 //! approximation: forward scattering, the light that crosses clear air
 //! from one cloud to another and a cloud's thin edges are transported as
-//! they are, and the second order keeps the light's forward peak
-//! (docs/ground_truth, 2026-12-06: the backlit view needs it).
+//! they are, and the second order keeps the light's forward peak, which
+//! the backlit view needs against the path tracer
+//! (docs/ground_truth/README.md).
 
 use std::f32::consts::PI;
 
@@ -22,7 +23,7 @@ use rayon::prelude::*;
 
 use super::exposure::luminance;
 use super::light_volume::{LIGHT_SUN_MIN, LightVolumeGrid};
-use super::renderer::ALBEDO;
+use super::lighting::{ALBEDO, sh9};
 
 /// A photon's random numbers: a 32-bit PCG stream (O'Neill's RXS-M-XS
 /// output), seeded per photon; 32 bits so that WGSL draws the same
@@ -82,26 +83,7 @@ pub fn scatter(dir: Vec3, rng: &mut Rng) -> Vec3 {
     (dir * cos + (a * phi.cos() + b * phi.sin()) * sin).normalize()
 }
 
-/// The real spherical harmonics to l = 2 at unit `d`, in the order
-/// (l, m) = (0, 0), (1, -1), (1, 0), (1, 1), (2, -2) … (2, 2), with `z`
-/// as the polar axis (`sh9` in WGSL).
-#[inline]
-pub fn sh9(d: Vec3) -> [f32; 9] {
-    let (x, y, z) = (d.x, d.y, d.z);
-    [
-        0.282_094_8,
-        0.488_602_5 * y,
-        0.488_602_5 * z,
-        0.488_602_5 * x,
-        1.092_548_4 * x * y,
-        1.092_548_4 * y * z,
-        0.315_391_57 * (3.0 * z * z - 1.0),
-        1.092_548_4 * x * z,
-        0.546_274_2 * (x * x - y * y),
-    ]
-}
-
-/// The band `l` of each of [`sh9`]'s coefficients.
+/// The band `l` of each of [`super::lighting::sh9`]'s coefficients.
 pub const SH_BAND: [usize; 9] = [0, 1, 1, 1, 2, 2, 2, 2, 2];
 
 /// The dual-lobe phase's Legendre moments for l = 0, 1, 2:
@@ -188,8 +170,9 @@ fn volume(grid: &LightVolumeGrid) -> f32 {
 /// hemisphere) or its floor (`from_top` false: the lower), all orders of
 /// scattering and the unscattered light. Not used by the renderers (the
 /// sky's light in cloud is a profile, `renderer::ambient_light`): the
-/// ground-truth study measured it (docs/ground_truth, 2026-12-06), and
-/// the tests check the estimator's scale with it.
+/// transport experiment (docs/ground_truth/transport_experiment.patch)
+/// transports the sky's and the ground's light with it, and the tests
+/// check the estimator's scale with it.
 pub fn trace_sky(
     grid: &LightVolumeGrid,
     sigma: &[f32],

@@ -31,7 +31,8 @@ use glam::{UVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::density::{DensityParams, Fields, density_at, noise_point, warped_lookup};
-use super::light_transport::{PHASE_MOMENTS, SH_BAND, sh9, trace};
+use super::light_transport::{PHASE_MOMENTS, SH_BAND, trace};
+use super::lighting::sh9;
 
 /// The horizontal side of a light cell, m: the grid takes the nearest
 /// even count of cells of about this size across the domain. Light
@@ -41,18 +42,17 @@ pub const LIGHT_CELL_M: f32 = 80.0;
 /// The height of a light cell, m: the nearest even count of cells of about
 /// this height across the band. Half the horizontal side: a cumulus layer
 /// is 1-2 km deep, about a dozen cells of 80 m, and the light falls from a
-/// cloud's sunlit top to its base. Against the path tracer
-/// (docs/ground_truth, 2026-12-06, gains refitted for each) 80 m cells
-/// left the backlit view at 10.2 % per pixel, 80 m wide and 40 m tall
-/// ones bring it to 9.6 % (the four views 9.6, 9.0, 8.9 and 9.1 %) for
-/// 45 % more build time; 40 m cubes need 4 times the photons and took
-/// over 6 times as long.
+/// cloud's sunlit top to its base. Against the path tracer, with the
+/// gains refitted for each size, 80 m cells leave the backlit view at
+/// 10.2 % per pixel and these 9.6 % (every fitted view under 10 %) for
+/// 45 % more build time; 40 m cubes need 4 times the photons and over 6
+/// times the time (docs/ground_truth/README.md).
 pub const LIGHT_CELL_HEIGHT_M: f32 = 40.0;
 /// The most cells along the domain's side and along the band's height
 /// (48 layers: cells of 40 m up to a band 1.92 km deep, taller beyond
-/// it). Kept at 48 when the layers went to 40 m: the largest grid is 1.8
-/// M cells, 177 MB on the GPU and a 64 MB copy of the sums per CPU
-/// thread, which deep convection's 12 km band reaches.
+/// it). 48 bounds the largest grid, which deep convection's 12 km band
+/// reaches, at 1.8 M cells: 177 MB on the GPU and a 64 MB copy of the
+/// sums per CPU thread.
 pub const LIGHT_CELLS_MAX: UVec3 = UVec3::new(192, 48, 192);
 /// The photons' seed: the same clouds and sun give the same light.
 pub const LIGHT_SEED: u32 = 1;

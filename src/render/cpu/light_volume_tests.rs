@@ -63,7 +63,7 @@ fn the_planes_scatter_the_light_through_the_phase() {
     for (i, j, k) in [(0, 0, 0), (1, 2, 3), (3, 1, 2)] {
         let c = &sh[g.index(i, j, k)];
         let d = Vec3::new(0.48, 0.6, 0.64);
-        let y = crate::render::cpu::light_transport::sh9(d);
+        let y = crate::render::cpu::lighting::sh9(d);
         let expected: f32 = (0..9)
             .map(|n| c[n] * PHASE_MOMENTS[SH_BAND[n]] * y[n])
             .sum();

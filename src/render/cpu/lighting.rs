@@ -1,15 +1,12 @@
 //! Light: phase functions, sun transmittance by a secondary march,
 //! multiple-scattering octaves and the energy-conserving step
-//! (README, "The renderer").
+//! (docs/renderer.md, "Light").
 
 use std::f32::consts::PI;
 
 use glam::Vec3;
 
 use super::density::{DensityParams, Fields, density_at, height_fraction, smoothstep};
-use super::renderer::{
-    AMBIENT_GAIN, AMBIENT_GAIN_ALONE, GROUND_LIGHT_GAIN, GROUND_LIGHT_GAIN_ALONE,
-};
 use crate::render::sampling::GOLDEN;
 
 /// Henyey-Greenstein phase function, 1/sr; integrates to 1 over the sphere.
@@ -27,8 +24,8 @@ pub fn phase_dual(cos_theta: f32, eccentricity: f32) -> f32 {
 
 /// The longest shadow ray toward the sun, m (`SHADOW_RAY_M` in WGSL): a
 /// sun 8° up crosses a 1.5 km band in 11 km, and the clouds that far
-/// toward it shade a low sun's light (docs/ground_truth: capped at 2 km,
-/// the low sun's single scattering was 3 times the path tracer's).
+/// toward it shade a low sun's light (capped at 2 km, the low sun's
+/// single scattering is 3 times the path tracer's; docs/ground_truth).
 pub const SHADOW_RAY_M: f32 = 12_000.0;
 
 /// The shadow ray's length over which it takes `render.shadow_steps`
@@ -60,7 +57,7 @@ pub fn shadow_ray_length(p: Vec3, sun_dir: Vec3, d: &DensityParams) -> f32 {
 /// [`SHADOW_STEP_FACTOR_MAX`] times `steps` in all (rounded up). A fixed
 /// count over a long ray takes long far steps, which step over the
 /// clouds between a low sun and the sample: 20 steps over the low sun's
-/// 11 km leaked nearly as much as the 2 km cap.
+/// 11 km leak nearly as much as a 2 km cap.
 #[inline]
 pub fn shadow_step_count(steps: u32, length: f32, forward: f32) -> u32 {
     let along = (length / SHADOW_STEP_SPAN_M).clamp(1.0, SHADOW_STEP_FACTOR_MAX);
@@ -82,11 +79,11 @@ pub const FORWARD_COS_MAX: f32 = 0.9;
 /// more toward the sun, where the forward lobe makes the sunlight
 /// scattered once most of a pixel's light, so the shadow ray's estimate
 /// is what the pixel shows. Few steps err toward bright there (the
-/// estimate `e^{-Σ σ Δt}` is convex in its samples): the path tracer's
-/// backlit view measured 16.6 % per pixel at 20 steps everywhere, 14.7 %
-/// with this (docs/ground_truth). Away from the sun a ray keeps its
-/// steps and its cost, and [`shadow_step_count`] keeps the longest rays'
-/// bound.
+/// estimate `e^{-Σ σ Δt}` is convex in its samples): against the path
+/// tracer's backlit view, 20 steps everywhere measured 16.6 % per pixel
+/// where this measured 14.7 % (docs/ground_truth/compare.py). Away from
+/// the sun a ray keeps its steps and its cost, and [`shadow_step_count`]
+/// keeps the longest rays' bound.
 #[inline]
 pub fn forward_step_factor(cos_theta: f32) -> f32 {
     1.0 + FORWARD_STEP_BOOST * smoothstep(FORWARD_COS_MIN, FORWARD_COS_MAX, cos_theta)
@@ -106,17 +103,16 @@ pub fn shadow_parts(steps: u32) -> f32 {
 /// Where each of a pixel's shadow samples sits in its step, in `[0, 1)`
 /// (`shadow_offset` in WGSL): the pixel's march dither shifted by the
 /// golden ratio, off the march's own placement; the same for every step
-/// of the ray. Samples fixed at the steps' centres (until 2026-12-04)
-/// gave every ray through a cloud the same aliasing: whole clouds too
-/// bright or too dark, and streaks across backlit clouds' shaded sides.
-/// Placed by the dither, whose per-frame offsets TSAA averages (and the
-/// CPU's `cpu_offsets`), the aliasing becomes a fine grain that averages
-/// out. Against the path tracer (docs/ground_truth), at 20 shadow steps:
-/// the backlit view's single scattering 12.4 % off per pixel (14.5 %
-/// centred), its full light 14.1 % (14.5 %), the four views summed 43.6
-/// points (44.1). An offset rotated by the golden ratio from step to step
-/// did worse (19.2 % single scattering): one offset for the whole ray
-/// keeps its samples evenly spread.
+/// of the ray. Samples at the steps' centres would give every ray
+/// through a cloud the same aliasing: whole clouds too bright or too
+/// dark, and streaks across backlit clouds' shaded sides. Placed by the
+/// dither, whose per-frame offsets TSAA averages (and the CPU's
+/// `cpu_offsets`), the aliasing becomes a fine grain that averages out:
+/// at 20 shadow steps the backlit view's single scattering measured
+/// 12.4 % off the path tracer's per pixel, 14.5 % with centred samples.
+/// One offset for the whole ray keeps its samples evenly spread; an
+/// offset rotated by the golden ratio from step to step measured 19.2 %
+/// (docs/ground_truth/single_scattering.sh).
 #[inline]
 pub fn shadow_offset(dither: f32) -> f32 {
     (dither + GOLDEN).fract()
@@ -145,11 +141,11 @@ pub struct ShadowSteps {
 /// cloud's own edge decides its light, without the long far steps of a
 /// linear growth, which step over small wisps. Reading the density as the
 /// primary march does (the detail noise included, at the level of detail
-/// of `footprint_m`, the primary sample's). The path tracer measured what
-/// leaving the detail out costs (docs/ground_truth): its mean stands in
-/// for the noise, small eroded wisps vanish from the shadow, and backlit
-/// clouds glowed 7 times too bright. Few long steps leak the same way
-/// (they step over the wisps): the default is 20 (`render.shadow_steps`).
+/// of `footprint_m`, the primary sample's). Without the detail its mean
+/// stands in for the noise, small eroded wisps vanish from the shadow,
+/// and backlit clouds glow 7 times too bright against the path tracer
+/// (docs/ground_truth/compare.py). Few long steps leak the same way (they
+/// step over the wisps): the default is 20 (`render.shadow_steps`).
 #[inline]
 pub fn sun_optical_depth(
     p: Vec3,
@@ -206,53 +202,48 @@ pub const OCTAVE_SCATTERING: f32 = 0.5;
 pub const OCTAVE_EXTINCTION: f32 = 0.5;
 /// Per octave, the factor on the phase function's eccentricity (`c`).
 /// Light scattered `n` times by a Henyey-Greenstein lobe of asymmetry
-/// `g` keeps `g^n` of it, and the forward lobe's `g` is 0.8, so 0.8 was
-/// the physical choice; fitted with the gains against the path tracer
-/// (docs/ground_truth, 2026-12-04), 0.9 does better: summed per-pixel
-/// error over its four views 44.8 at 0.8, 44.4 at 0.85, 44.1 at 0.9,
-/// 46.8 at 1.0 (the backlit view's 14.4 % then 14.5 %, the high sun's
-/// 10.7 % then 9.9 %). The octaves keep more of the forward peak than
-/// one lobe's `g^n`: a cloud's light has few orders of scattering near
-/// its sunlit skin, where the octaves matter.
+/// `g` keeps `g^n` of it, and the forward lobe's `g` is 0.8, so 0.8 is
+/// the physical choice; with the gains fitted at each value against the
+/// path tracer, 0.9 scores best over the four views
+/// (docs/ground_truth/fit_gains.py). The octaves keep more of the
+/// forward peak than one lobe's `g^n`: a cloud's light has few orders of
+/// scattering near its sunlit skin, where the octaves matter.
 pub const OCTAVE_ECCENTRICITY: f32 = 0.9;
 /// The gain on the octaves' forward-scattered light (the phase
 /// function's lobes at the octave's eccentricity) at a sun in the zenith
 /// (fitted, as [`MULTIPLE_ISOTROPIC_GAIN`], [`DIFFUSE_GAIN`],
-/// [`FLUENCE_GAIN`] and the sky's and the ground's gains are;
-/// docs/ground_truth).
+/// [`FLUENCE_GAIN`] and the sky's and the ground's gains are, by
+/// docs/ground_truth/fit_tops.py on fit_gains.py's part renders, four
+/// views, the tops held within 9.5 %; figures in
+/// docs/ground_truth/README.md).
 pub const MULTIPLE_GAIN: f32 = 0.202;
 /// [`MULTIPLE_GAIN`] where no light volume is built ([`LightGains::ALONE`]).
 pub const MULTIPLE_GAIN_ALONE: f32 = 0.53;
 /// The gain on the octaves' isotropic light: light scattered many times
-/// leaves a cloud in every direction, not only in the phase's lobes. It
-/// was 0.91 before the light volume, which now carries most of that
-/// light ([`FLUENCE_GAIN`]); beside the transported light the fit keeps
-/// 0.256 of it, for the light near the sunlit skin the cells blur.
+/// leaves a cloud in every direction, not only in the phase's lobes. The
+/// light volume carries most of that light ([`FLUENCE_GAIN`]); beside it
+/// the fit keeps this much, for the light near the sunlit skin that the
+/// cells blur.
 pub const MULTIPLE_ISOTROPIC_GAIN: f32 = 0.256;
 /// [`MULTIPLE_ISOTROPIC_GAIN`] where no light volume is built.
 pub const MULTIPLE_ISOTROPIC_GAIN_ALONE: f32 = 0.46;
 /// The octaves scale with the sun's height as
-/// `sin(elevation)^MULTIPLE_SUN_POWER`. It was 0.4 from before the light
-/// volume, when the octaves also stood for the light a whole layer takes
-/// in, which falls with the sun's flux through it; the light volume now
-/// carries that light, and the octaves the light near each cloud's
-/// sunlit skin, which a low sun lights side-on as well. Refitted with
-/// the gains on the rounded tops (docs/ground_truth, 2026-12-05),
-/// summed per-pixel error over the four views with the tops held within
-/// 9.5 %: 44.9 at 0.4 (the high sun 11.2 %), 44.2 at 0.3, 43.6 at 0.2,
-/// 43.5 at 0.1 and at 0. 0.2 is the one power with both the high and
-/// the low sun at about 10 % or under (9.9 and 10.0 %; at 0.3 the high
-/// sun is 10.6 %, at 0.1 and 0 the low sun 10.2 and 10.4 %).
+/// `sin(elevation)^MULTIPLE_SUN_POWER`, a weak power: the light a whole
+/// layer takes in, which falls with the sun's flux through it, is the
+/// light volume's and the diffused sunlight's, and the octaves carry the
+/// light near each cloud's sunlit skin, which a low sun lights side-on
+/// as well. With the gains refitted at each power (four views, the tops
+/// held), 0.2 is the one that keeps both the high and the low sun at
+/// about 10 % per pixel or under (docs/ground_truth/fit_tops.py).
 pub const MULTIPLE_SUN_POWER: f32 = 0.2;
 /// The gain on the diffused sunlight ([`diffused_sun`]) at a sun in the
-/// zenith. Held at 0.1 in the fits beside the diffusion (docs/ground_truth,
-/// 2026-12-04 and 2026-12-05), for the renderers that build no light
-/// volume (the spheroids' and the volume's), which have only this to
-/// fill deep cloud; beside the transported light the fit with the tops
-/// held gives 0.019 (2026-12-06), and those renderers' deep cloud is that
-/// much darker: they take [`DIFFUSE_GAIN_ALONE`] ([`LightGains`]).
+/// zenith, as the fit beside the transported light gives it. The
+/// renderers that build no light volume (the spheroids' and the
+/// volume's) have only this term to fill deep cloud, which this little
+/// leaves too dark: they take [`DIFFUSE_GAIN_ALONE`] ([`LightGains`]).
 pub const DIFFUSE_GAIN: f32 = 0.019;
-/// [`DIFFUSE_GAIN`] where no light volume is built.
+/// [`DIFFUSE_GAIN`] where no light volume is built, held at 0.1 in the
+/// fit of [`LightGains::ALONE`] so that the term fills deep cloud.
 pub const DIFFUSE_GAIN_ALONE: f32 = 0.1;
 /// A sample carries the diffused sunlight in proportion to its opacity
 /// over this many metres, `1 - e^{-σ_t · DIFFUSE_DEPTH_M}`: it fills
@@ -283,8 +274,8 @@ pub fn diffused_sun(mu_sun: f32, sigma_t: f32, gains: &LightGains) -> f32 {
 /// 1 and the octaves took nothing from it. The cells blur a cloud's
 /// sunlit skin into its shaded inside, where the light is weaker: the
 /// octaves carry the skin's light, and the volume gives some of that back.
-/// (0.766 with cells 80 m tall; the diffusion it replaced, 2026-12-06,
-/// asked for 1.19.)
+/// The value belongs to the light volume's cells (with cells 80 m tall
+/// the fit gives 0.766): a change to their size asks for a refit.
 pub const FLUENCE_GAIN: f32 = 0.915;
 
 /// The six fitted gains of the light (`light_gains` in WGSL, which picks
@@ -303,8 +294,8 @@ pub struct LightGains {
 
 impl LightGains {
     /// Beside the transported light volume (fitted to the path tracer
-    /// with it, 2026-12-06): the cloud map's renderer with multiple
-    /// scattering on.
+    /// with it, docs/ground_truth/fit_tops.py): the cloud map's renderer
+    /// with multiple scattering on.
     pub const TRANSPORT: Self = Self {
         multiple: MULTIPLE_GAIN,
         multiple_isotropic: MULTIPLE_ISOTROPIC_GAIN,
@@ -315,11 +306,11 @@ impl LightGains {
     };
     /// Where no light volume is built (the spheroids' and the volumes'
     /// renderers; the cloud map's with `render.light_photons = 0`): the
-    /// gains fitted beside the diffusion (2026-12-05), under which these
-    /// renderers were drawn until the transport. Beside the transport the
-    /// fit gives the ground's light nothing and the octaves half as much,
-    /// which leaves a renderer without the volume's light navy in its
-    /// shade.
+    /// gains of the fit in which a diffusion on the light grid stood for
+    /// the transported light (docs/ground_truth/README.md). The
+    /// transport's own gains give the ground's light nothing and the
+    /// octaves half as much, which leaves a renderer without the volume's
+    /// light navy in its shade.
     pub const ALONE: Self = Self {
         multiple: MULTIPLE_GAIN_ALONE,
         multiple_isotropic: MULTIPLE_ISOTROPIC_GAIN_ALONE,
@@ -354,13 +345,14 @@ pub fn light_gains(volume: bool) -> LightGains {
 /// The light volume's term
 /// ([`super::light_volume::LightVolume::light_toward`]) is added beside
 /// this one (`renderer::diffused_light`). The six gains (the octaves' two,
-/// the two diffused lights', the sky's [`super::renderer::AMBIENT_GAIN`]
-/// and the ground's [`super::renderer::GROUND_LIGHT_GAIN`]) were fitted to Mitsuba
+/// the two diffused lights', the sky's [`super::lighting::AMBIENT_GAIN`]
+/// and the ground's [`super::lighting::GROUND_LIGHT_GAIN`]) were fitted to Mitsuba
 /// 3's volumetric path tracer (all orders of scattering) on four views: a
 /// high sun, a low sun, a backlit view and a side view (docs/ground_truth:
 /// the model chosen with `surrogate.py`, the gains fitted on the
-/// renderer's own parts). Forward octaves alone, however fitted, left 18-21 %
-/// per pixel: they dim deep cloud, where the path tracer's light stays.
+/// renderer's own parts). Forward octaves alone, however fitted, leave
+/// 18-21 % per pixel: they dim deep cloud, where the path tracer's light
+/// stays.
 #[inline]
 pub fn sun_scattering(
     tau_sun: f32,
@@ -396,6 +388,54 @@ pub fn integrate_step(s: Vec3, sigma_t: f32, dt: f32) -> Vec3 {
         return s * dt;
     }
     (s - s * (-sigma_t * dt).exp()) / sigma_t
+}
+
+/// Single-scattering albedo of cloud droplets.
+pub const ALBEDO: f32 = 0.99;
+
+/// The gain on the sky's light in cloud (`AMBIENT_GAIN` in WGSL):
+/// isotropic scattering of the upper sky's irradiance (`sky_above(up) /
+/// 4`), 0.35 of it at the band's bottom and all of it at its top
+/// ([`super::renderer::ambient_light`]), times this, which stands for that light's own
+/// multiple scattering; fitted with the octaves and the transported
+/// sunlight ([`sun_scattering`], [`FLUENCE_GAIN`]) and
+/// [`GROUND_LIGHT_GAIN`] (docs/ground_truth/fit_tops.py).
+pub const AMBIENT_GAIN: f32 = 4.355;
+/// [`AMBIENT_GAIN`] where no light volume is built
+/// ([`LightGains::ALONE`]).
+pub const AMBIENT_GAIN_ALONE: f32 = 4.37;
+
+/// The gain on the ground's light in cloud (`GROUND_LIGHT_GAIN` in
+/// WGSL): isotropic scattering of the ground's upward irradiance
+/// (`ground_up / 4`), all of it at the band's bottom and none at its top
+/// ([`super::renderer::ambient_light`]), times this. It is 0 beside the
+/// transported sunlight, which reaches the bases through the clouds as
+/// the path tracer's does: the fit (docs/ground_truth/fit_tops.py) puts
+/// it at 0 or within 0.011 of it, where no view's error moves by more
+/// than 0.0002. The path-traced references light the clouds from below
+/// only through their environment's lower half, so a refit against
+/// references with a ground may want it back.
+pub const GROUND_LIGHT_GAIN: f32 = 0.0;
+/// [`GROUND_LIGHT_GAIN`] where no light volume is built.
+pub const GROUND_LIGHT_GAIN_ALONE: f32 = 3.82;
+
+/// The real spherical harmonics to l = 2 at unit `d`, in the order
+/// (l, m) = (0, 0), (1, -1), (1, 0), (1, 1), (2, -2) … (2, 2), with `z`
+/// as the polar axis (`sh9` in WGSL).
+#[inline]
+pub fn sh9(d: Vec3) -> [f32; 9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_094_8,
+        0.488_602_5 * y,
+        0.488_602_5 * z,
+        0.488_602_5 * x,
+        1.092_548_4 * x * y,
+        1.092_548_4 * y * z,
+        0.315_391_57 * (3.0 * z * z - 1.0),
+        1.092_548_4 * x * z,
+        0.546_274_2 * (x * x - y * y),
+    ]
 }
 
 #[cfg(test)]

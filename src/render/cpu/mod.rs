@@ -1,6 +1,7 @@
-//! The CPU reference renderer. Each function here has (or will have) a
-//! WGSL twin of the same name in `shaders/clouds.wgsl`: pure functions on
-//! plain `f32` data and glam vectors.
+//! The CPU reference renderer. Each module's functions that the GPU also
+//! runs have a WGSL twin of the same name in `shaders/<module>.wgsl`
+//! (`tests/shader_twins.rs`): pure functions on plain `f32` data and glam
+//! vectors.
 //!
 //! World frame: `x` east, `y` up, `z` north, metres. The physics domain's
 //! `(x, y)` maps to the world's `(x, z)`; P and the cloud map both span
@@ -8,7 +9,9 @@
 //! non-periodic warp outside the simulated domain (`density::domain_warp`).
 
 pub mod density;
+pub mod density_grid;
 pub mod exposure;
+pub mod frame;
 pub mod glare;
 pub mod land;
 pub mod light_transport;

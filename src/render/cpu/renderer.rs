@@ -8,129 +8,19 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 use super::density::{DensityParams, Fields, band_segment, density_at};
+use super::frame::{Frame, MIN_TRANSMITTANCE};
 use super::land::{flat_ground_albedo, terrain_albedo};
-use super::light_volume::LightVolume;
 use super::lighting::{
-    LightGains, ShadowSteps, forward_step_factor, integrate_step, light_gains, shadow_offset,
-    sun_optical_depth, sun_scattering,
+    ALBEDO, LightGains, ShadowSteps, forward_step_factor, integrate_step, light_gains,
+    shadow_offset, sun_optical_depth, sun_scattering,
 };
 use super::sea::sea_reflection_change;
 use super::sky::{
-    AtmosphereConfig, SkyLight, aerial, background_radiance, ground_cloud_light, ground_up,
-    sky_ambient, sun_direction, sun_light_at,
-};
-use super::sky_luts::SkyLuts;
-pub use super::stills::{
-    add_sun_glare, glare_source, render_clouds_linear, render_converged, render_linear,
-    render_linear_offsets, render_still, still_srgb8, supersampled_srgb8,
-};
-pub use super::tone_map::{
-    ACES_INPUT, ACES_OUTPUT, aces_curve, srgb_encode, to_srgb8, to_srgb8_exact, tone_map,
+    aerial, background_radiance, ground_up, sky_ambient, sun_direction, sun_light_at,
 };
 use super::waves::sea_waves_at;
-use crate::render::camera::View;
 use crate::render::sampling;
 use crate::render::terrain::Heightfield;
-
-/// Quality and look (scene table `[render]` keys that are not camera,
-/// sun or cloud map).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quality {
-    /// Primary march samples across the band segment.
-    pub steps: u32,
-    /// Secondary march samples toward the sun (0: no self-shadowing).
-    pub shadow_steps: u32,
-    /// Extra multiple-scattering octaves, 0..=3.
-    pub octaves: u32,
-    /// Photons the light volume traces per column of its cells
-    /// (`render.light_photons`; 0: no light volume).
-    pub light_photons: u32,
-    /// Distance at which the analytic model's aerial perspective has
-    /// faded a cloud to 1/e, m.
-    pub haze_distance_m: f32,
-    /// Rays stop after this distance, m.
-    pub max_distance_m: f32,
-    /// Exposure multiplier before tone mapping.
-    pub exposure: f32,
-    /// The strength of the sun's glare in tone-mapped pictures
-    /// (`render.sun_glare`; [`super::glare`]): 1 the CIE's eye, 0 none.
-    pub sun_glare: f32,
-    /// The sea below the horizon with this wind speed, m/s (`None`:
-    /// land; [`super::sky::background_radiance`]).
-    pub sea_wind_mps: Option<f32>,
-    /// The direction the sea's wind blows toward, degrees clockwise from
-    /// north: the waves run along it ([`super::waves::sea_waves`]).
-    pub sea_wind_toward_deg: f32,
-    /// The sea's clock, s: where its waves are in their travel
-    /// ([`super::waves::sea_waves`]). The CLI's stills take
-    /// `render.time_s`; the GPU renderer's
-    /// [`crate::render::gpu::CloudRenderer::set_sea_time`] moves it per frame.
-    pub sea_time_s: f32,
-    /// The land drawn as fields and woods
-    /// ([`super::land::land_albedo`]); off: one colour,
-    /// [`super::sky::LAND_ALBEDO`]. Off under the sea.
-    pub land_fields: bool,
-    /// The sky model and aerial perspective (`[render.atmosphere]`).
-    pub atmosphere: AtmosphereConfig,
-    /// Only the sun's light scattered once: no octaves, no sky or ground
-    /// light in the clouds, nothing behind them (black) and no haze in
-    /// front; what a path tracer limited to one scattering renders
-    /// (`cumulus render --single-scattering`, docs/ground_truth). Scenes
-    /// never set it.
-    pub single_scattering: bool,
-}
-
-/// Single-scattering albedo of cloud droplets.
-pub const ALBEDO: f32 = 0.99;
-/// Transmittance below which the march stops (opacity early exit).
-pub const MIN_TRANSMITTANCE: f32 = 0.01;
-
-/// Everything a frame needs.
-#[derive(Clone, Copy)]
-pub struct Frame<'a> {
-    /// The camera (a scene's [`crate::render::camera::Camera`] made a view
-    /// with the image's aspect, or an application's matrices).
-    pub view: View,
-    pub sun_elevation_deg: f32,
-    pub sun_azimuth_deg: f32,
-    pub fields: Fields<'a>,
-    pub density: DensityParams,
-    pub quality: Quality,
-    /// The terrain, when the scene has one (none: nothing is marched).
-    pub terrain: Option<&'a Heightfield>,
-    /// The physical sky's tables for this frame's sun and camera altitude
-    /// (`quality.atmosphere.sky_params()`; none: the analytic sky).
-    pub sky: Option<&'a SkyLuts>,
-    /// The share of the ground under cloud, 0..1 (P's covered fraction,
-    /// [`crate::sim::ProjectedField::covered_fraction`]): how much
-    /// sunlight the clouds scatter down onto the land
-    /// ([`super::sky::ground_cloud_light`]).
-    pub cloud_cover: f32,
-    /// The sunlight scattered more than once through the clouds
-    /// ([`LightVolume`], built for this frame's field, density and sun;
-    /// none: the term is left out, as with no octaves, and the light
-    /// takes the gains of a renderer without one,
-    /// [`super::lighting::LightGains::ALONE`]).
-    pub light: Option<&'a LightVolume>,
-}
-
-impl Frame<'_> {
-    /// What the sky functions read of this frame
-    /// ([`super::sky::SkyLight`]).
-    pub fn sky_light(&self) -> SkyLight<'_> {
-        let mut sky = SkyLight {
-            luts: self.sky,
-            aerial_perspective: self.quality.atmosphere.aerial_perspective,
-            haze_distance_m: self.quality.haze_distance_m,
-            camera_altitude_m: self.view.eye().y,
-            ground_cloud_light: Vec3::ZERO,
-        };
-        let sun_dir = sun_direction(self.sun_elevation_deg, self.sun_azimuth_deg);
-        let middle = 0.5 * (self.density.band_bottom_m + self.density.band_top_m);
-        sky.ground_cloud_light = ground_cloud_light(&sky, sun_dir, self.cloud_cover, middle);
-        sky
-    }
-}
 
 /// The result of marching one ray: linear radiance and the transmittance
 /// of the clouds along it.
@@ -198,44 +88,12 @@ pub fn march_step_count(steps: u32, log_ratio: f32) -> u32 {
 /// Sub-samples of a coarse march interval that touches cloud.
 pub const REFINE: u32 = 4;
 
-/// Relative sun irradiance: sunlight is about five times the sky's
-/// illuminance on a clear day, so a sunlit cloud is brighter than the sky.
-pub const SUN_INTENSITY: f32 = 8.0;
-
-/// The gain on the sky's light in cloud (`AMBIENT_GAIN` in WGSL):
-/// isotropic scattering of the upper sky's irradiance (`sky_above(up) /
-/// 4`), 0.35 of it at the band's bottom and all of it at its top
-/// ([`ambient_light`]), times this, which stands for that light's own
-/// multiple scattering; fitted with the octaves and the transported
-/// sunlight ([`super::lighting::sun_scattering`], [`super::lighting::FLUENCE_GAIN`]) and
-/// [`GROUND_LIGHT_GAIN`] (4.37 beside the diffusion).
-pub const AMBIENT_GAIN: f32 = 4.355;
-/// [`AMBIENT_GAIN`] where no light volume is built
-/// ([`super::lighting::LightGains::ALONE`]).
-pub const AMBIENT_GAIN_ALONE: f32 = 4.37;
-
-/// The gain on the ground's light in cloud (`GROUND_LIGHT_GAIN` in
-/// WGSL): isotropic scattering of the ground's upward irradiance
-/// (`ground_up / 4`), all of it at the band's bottom and none at its top
-/// ([`ambient_light`]), times this. Beside the diffusion the fit wanted
-/// 3.82 (the diffusion left the bases too dark); beside the transported
-/// sunlight, which reaches the bases through the clouds as it does in
-/// the path tracer, every fit with the gains at 0 or more put it at 0 or
-/// near it (0.011 with the 40 m layers, where 0 moves no view's error by
-/// more than 0.0002; docs/ground_truth, 2026-12-06; the references light the clouds from
-/// below only through the exported environment's lower half). The term
-/// is kept for a refit against references with a ground, but at 0 the
-/// renderers add nothing from it.
-pub const GROUND_LIGHT_GAIN: f32 = 0.0;
-/// [`GROUND_LIGHT_GAIN`] where no light volume is built.
-pub const GROUND_LIGHT_GAIN_ALONE: f32 = 3.82;
-
 /// The sky's and the ground's light scattered at height fraction `eta` of
 /// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4`, weighted
 /// from 0.35 at the bottom to 1 at the top, times the `gains`' `ambient`
-/// ([`AMBIENT_GAIN`] beside the light volume), and the ground's `ground /
+/// ([`super::lighting::AMBIENT_GAIN`] beside the light volume), and the ground's `ground /
 /// 4`, weighted from 1 at the bottom to 0 at the top, times their
-/// `ground` ([`GROUND_LIGHT_GAIN`]).
+/// `ground` ([`super::lighting::GROUND_LIGHT_GAIN`]).
 #[inline]
 pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32, gains: &LightGains) -> Vec3 {
     sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground)
@@ -244,7 +102,7 @@ pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32, gains: &LightGains) 
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
 /// in `[0, 1)` places the samples within their steps (0.5: centres) and,
 /// through [`shadow_offset`], each lit sample's shadow samples in theirs;
-/// `spread` is the pixel's cone angle (radians, [`View::pixel_spread`]):
+/// `spread` is the pixel's cone angle (radians, [`crate::render::camera::View::pixel_spread`]):
 /// a sample at distance `t` reads the textures at the level of detail of
 /// a footprint `spread · t` wide.
 pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) -> RaySample {
@@ -375,7 +233,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
 
 /// The light volume's transported sunlight at `p` scattered toward the
 /// eye (`to_eye`, against the ray), per unit scattering coefficient and
-/// sun irradiance ([`LightVolume::light_toward`] times the transport's
+/// sun irradiance ([`super::light_volume::LightVolume::light_toward`] times the transport's
 /// gain, [`super::lighting::FLUENCE_GAIN`]): 0 without one or without multiple scattering
 /// (`octaves` 0).
 #[inline]

@@ -1,4 +1,5 @@
 use super::*;
+use crate::render::cpu::lighting::{AMBIENT_GAIN_ALONE, GROUND_LIGHT_GAIN_ALONE};
 
 /// The coarse steps span the segment exactly, grow with distance along
 /// a long horizontal ray, and are uniform looking down on the band.
@@ -51,8 +52,8 @@ fn ground_light_reaches_the_base_not_the_top() {
 /// A ray 3° up from 60 m under the default band (579-1600 m) crosses it
 /// from about 10 to 30 km: its coarse steps stay short enough, for their
 /// distance, to hit the clouds there (at the scene's 48 steps alone they
-/// were 250-640 m long, and clouds between two steps' ends came and went
-/// with the dither: stripes along the horizon). Rays that look up steeply
+/// would be 250-640 m long, and clouds between two steps' ends would come
+/// and go with the dither: stripes along the horizon). Rays that look up steeply
 /// keep the scene's steps, and none takes more than the cap.
 #[test]
 fn grazing_rays_take_more_steps() {

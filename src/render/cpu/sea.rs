@@ -4,19 +4,19 @@
 //! (`sea_reflection`) and what it changes in the pixel
 //! (`sea_reflection_change`, which the GPU's cloud pass adds to its
 //! layer). Twins of the WGSL functions of the same names in
-//! `shaders/clouds.wgsl`.
+//! `shaders/sea.wgsl`.
 
 use std::f32::consts::PI;
 
 use glam::Vec3;
 
 use super::density::{band_segment, density_at};
+use super::frame::{Frame, MIN_TRANSMITTANCE};
+use super::lighting::ALBEDO;
 use super::lighting::{integrate_step, light_gains, sun_scattering};
 #[cfg(doc)]
 use super::renderer::march_ray;
-use super::renderer::{
-    ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, cloud_shadow, diffused_light,
-};
+use super::renderer::{ambient_light, cloud_shadow, diffused_light};
 use super::sky::{
     ground_haze_transmittance, ground_up, mirrored_sky, sea_fresnel, sea_mirror, sky_ambient,
     sun_light_at,
@@ -25,10 +25,10 @@ use super::waves::{flat_sea, sea_waves_at};
 use crate::render::sampling::GOLDEN;
 
 /// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
-/// per stratum of the waves' slopes ([`reflected_elevation`]). 12: the
-/// 6 used until 2026-12-04 left BOMEX's CPU picture (four offsets a
-/// pixel) with the mirrored clouds as grain; the GPU's TSAA averages
-/// either over its frames.
+/// per stratum of the waves' slopes ([`reflected_elevation`]). 12, so
+/// that BOMEX's CPU picture (four offsets a pixel) shows the mirrored
+/// clouds without grain, which 6 leave; the GPU's TSAA averages either
+/// over its frames.
 pub const REFLECTION_RAYS: u32 = 12;
 /// The fewest uniform steps of the march of each reflected ray
 /// (`REFLECTION_STEPS` in WGSL); a long one takes more
@@ -45,11 +45,11 @@ pub const REFLECTION_STEP_M: f32 = 300.0;
 /// [`REFLECTION_STEPS_MAX`]. A step much wider than a cloud lands in
 /// it or misses it, and counts it as a slab of the step's depth when it
 /// lands: the reflection's mean falls short by the cloud's width over the
-/// step. The fixed 4 steps used until 2026-12-04, 1.3 km each across a
-/// ray rising at 10° through BOMEX's 900 m band, showed the mirrored
-/// clouds far dimmer than 16 steps do, as sparse bright grain; over
-/// rays rising at 10° through a 1 km band their mean opacity was 0.82
-/// of a fine march's (`a_reflected_rays_march_does_not_step_over_clouds`).
+/// step. A fixed 4 steps, 1.3 km each across a ray rising at 10° through
+/// BOMEX's 900 m band, show the mirrored clouds far dimmer than 16 steps
+/// do, as sparse bright grain; over rays rising at 10° through a 1 km
+/// band their mean opacity is 0.82 of a fine march's
+/// (`a_reflected_rays_march_does_not_step_over_clouds`).
 #[inline]
 pub fn reflection_step_count(length: f32) -> u32 {
     ((length / REFLECTION_STEP_M).ceil().max(0.0) as u32)

@@ -21,12 +21,15 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::lighting::phase_hg;
-use super::renderer::SUN_INTENSITY;
 use super::sea::{reflected_elevation, reflected_ray};
 use super::sky_luts::{
     SkyLuts, SkyParams, aerial_perspective, sky_view_radiance, sun_disk_radiance, sun_radiance_at,
 };
 use super::waves::wave_normal;
+
+/// Relative sun irradiance: sunlight is about five times the sky's
+/// illuminance on a clear day, so a sunlit cloud is brighter than the sky.
+pub const SUN_INTENSITY: f32 = 8.0;
 
 /// Cosine of the analytic sun disk's angular radius (0.27°).
 pub const SUN_DISK_COS: f32 = 0.999_989;
@@ -290,7 +293,8 @@ pub fn land_radiance(sky: &SkyLight, dir: Vec3, sun_dir: Vec3, shadow: f32, albe
 /// cloud layer covering the whole sky would send down onto the land as
 /// diffuse light ([`ground_cloud_light`]). Fitted to Mitsuba's path
 /// tracer over a Lambertian plane under the fair-weather clouds (P 34 %
-/// covered; docs/ground_truth, "the land under the clouds"): its diffuse
+/// covered; docs/ground_truth/ground_shadow.py, figures in
+/// docs/renderer.md, "The land under the clouds"): its diffuse
 /// light beyond the clear sky's asks for 0.54 and 0.44 (suns 60° and 30°
 /// high) in the deepest shade and 0.59 and 0.62 averaged over all the
 /// land; 0.53 keeps both within 7 % at both suns.
@@ -302,7 +306,7 @@ pub const GROUND_CLOUD_LIGHT: f32 = 0.53;
 /// sun's horizontal irradiance at the band's middle height
 /// `band_middle_m`, over π. The land in the clouds' shade gets the sky's
 /// light and this, which is the sun's colour, nearly white: without it
-/// the shade had half the path tracer's light and its blue.
+/// the shade has half the path tracer's light and its blue.
 #[inline]
 pub fn ground_cloud_light(sky: &SkyLight, sun_dir: Vec3, cover: f32, band_middle_m: f32) -> Vec3 {
     sun_light_at(sky, band_middle_m, sun_dir)
@@ -461,10 +465,10 @@ pub const SKY_MIRROR_RAYS: u32 = 8;
 /// of the slopes the pixel does not resolve
 /// ([`super::sea::reflected_elevation`]; turned up or down, not
 /// sideways, since the sky changes little in azimuth). A flat mirror
-/// (until 2026-12-05) showed the far sea as bright as the sky at the
-/// horizon: its rough waves send the reflected rays on average 10-15°
-/// up, to a deeper sky, and the waves drawn near the camera, which do,
-/// met it in a visible step.
+/// would show the far sea as bright as the sky at the horizon, where its
+/// rough waves send the reflected rays on average 10-15° up, to a deeper
+/// sky, and the waves drawn near the camera, which do, would meet it in a
+/// visible step.
 #[inline]
 pub fn mirrored_sky(sky: &SkyLight, dir: Vec3, waves: Vec3, sun_dir: Vec3) -> Vec3 {
     let r0 = sea_mirror(dir, waves);

@@ -100,9 +100,9 @@ mod physical {
     /// spread them by 16°, none below the horizon): `mirrored_sky`'s eight
     /// strata come within 1 % of that mean over 4000, which away from the
     /// sun is a few per cent darker than the sky at the horizon; a calm
-    /// sea's mirror is the horizon's. The flat mirror used until
-    /// 2026-12-05 gave the horizon's sky whatever the wind (3.4 % off
-    /// here, more under a hazier horizon).
+    /// sea's mirror is the horizon's. A flat mirror would give the
+    /// horizon's sky whatever the wind (3.4 % off here, more under a
+    /// hazier horizon).
     #[test]
     fn a_rough_sea_mirrors_the_mean_sky_of_its_slopes() {
         let (l, sun) = luts(40.0, 30.0);

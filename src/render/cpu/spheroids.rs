@@ -14,10 +14,13 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::frame::{Frame, MIN_TRANSMITTANCE};
+use super::lighting::ALBEDO;
 use super::lighting::{LightGains, integrate_step, sun_scattering};
-use super::renderer::{ALBEDO, Frame, MIN_TRANSMITTANCE, ambient_light, to_srgb8};
+use super::renderer::ambient_light;
 use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
 use super::standalone::{analytic, hazed_clouds, render_standalone};
+use super::tone_map::to_srgb8;
 
 /// How far the fBm moves a spheroid's surface (κ of their Eq. 2).
 pub const SPHEROID_KAPPA: f32 = 0.35;

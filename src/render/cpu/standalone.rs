@@ -8,8 +8,8 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::frame::Frame;
 use super::land::flat_ground_albedo;
-use super::renderer::Frame;
 use super::sky::{SkyLight, aerial, background_radiance, sun_direction};
 use super::waves::sea_waves_at;
 use crate::render::sampling::frame_offset;

@@ -1,13 +1,14 @@
 //! Pictures made of the renderer's marches ([`super::renderer::march_ray`]):
 //! one march a pixel, the mean of the frames TSAA accumulates, the
 //! clouds-only layer, the CLI's stills with the sun's glare, and the
-//! supersampled reference; re-exported by `renderer`.
+//! supersampled reference.
 
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::frame::Frame;
 use super::glare::{add_glare, sun_visibility};
-use super::renderer::{Frame, RaySample, march_ray, pixel_dither};
+use super::renderer::{RaySample, march_ray, pixel_dither};
 use super::sky::{sun_direction, sun_disk_irradiance};
 use super::tone_map::to_srgb8;
 use crate::render::sampling::{frame_offset, jitter};
@@ -47,7 +48,7 @@ pub fn render_converged(width: u32, height: u32, fr: &Frame, frames: u32) -> Vec
 /// accumulates ([`render_converged`]: each frame's sub-pixel jitter and
 /// dither offset), so edges are anti-aliased as the GPU's accumulated
 /// frames are (through pixel centres alone, the far ground's cloud
-/// shadows and the clouds' outlines against the sky were staircases);
+/// shadows and the clouds' outlines against the sky are staircases);
 /// with 1, one march through each pixel's centre ([`render_linear`]).
 pub fn render_still(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec3> {
     if offsets <= 1 {

@@ -1,5 +1,6 @@
 //! The tone map of the PNG pictures (ACES filmic, then sRGB), the twin
-//! of WGSL's `tone_map` and `aces_curve`; re-exported by `renderer`.
+//! of `shaders/tone_map.wgsl` (`tone_map`, `aces_curve`) and of
+//! `shaders/composite.wgsl`'s sRGB output.
 
 use glam::Vec3;
 
@@ -44,7 +45,7 @@ fn mul_rows(m: &[[f32; 3]; 3], v: Vec3) -> Vec3 {
 /// rendering and sRGB output transforms, [`aces_curve`]) of the linear
 /// radiance times `exposure`, to display-linear `0..1`. Bright sunlit
 /// cloud rolls off to white and desaturates as film does, instead of the
-/// grey that a per-channel exponential left it at. The images, the
+/// grey that a per-channel exponential leaves it at. The images, the
 /// quality report and the GPU's composite pass (`tone_map` in WGSL) use it.
 #[inline]
 pub fn tone_map(c: Vec3, exposure: f32) -> Vec3 {
@@ -187,7 +188,7 @@ mod tests {
     /// The fitted ACES curve's landmarks, its monotony and its roll-off:
     /// black stays black, a neutral grey stays neutral, brighter is never
     /// darker, and a highlight 30 times mid grey is near white but not
-    /// clipped (the old exponential map reached 0.997 there).
+    /// clipped (an exponential map reaches 0.997 there).
     #[test]
     fn the_tone_map_is_filmic() {
         assert!(tone_map(Vec3::ZERO, 1.0).max_element() < 2e-3);

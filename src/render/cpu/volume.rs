@@ -16,10 +16,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 
 use super::density::band_segment;
+use super::frame::{Frame, MIN_TRANSMITTANCE};
+use super::lighting::ALBEDO;
 use super::lighting::{LightGains, integrate_step, shadow_ray_length, sun_scattering};
-use super::renderer::{
-    ALBEDO, Frame, MIN_TRANSMITTANCE, NEAR_M, ambient_light, march_distance, march_step_count,
-};
+use super::renderer::{NEAR_M, ambient_light, march_distance, march_step_count};
 use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
 use super::standalone::{analytic, hazed_clouds, render_standalone};
 

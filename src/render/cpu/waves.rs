@@ -3,7 +3,7 @@
 //! camera), and whose slopes a pixel cannot resolve stay in the glint's
 //! statistical roughness (far away), so the two together always hold
 //! Cox and Munk's (1954) slope variance. Twins of the WGSL functions of
-//! the same names in `shaders/clouds.wgsl`.
+//! the same names in `shaders/waves.wgsl`.
 //!
 //! Each train travels along its direction at deep water's phase speed,
 //! on the sea's clock (`Quality::sea_time_s`).
@@ -13,14 +13,14 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::density::smoothstep;
-use super::renderer::Frame;
+use super::frame::Frame;
 use crate::render::sampling::GOLDEN;
 
 /// Wave trains summed (`WAVE_COUNT` in WGSL), their wavelengths evenly
 /// spread in ratio over [`WAVE_OCTAVES`] below [`WAVE_LONGEST_M`], about
 /// five an octave. With two an octave (15 trains) the few a pixel
-/// resolves from 300 m up made a lattice of diamonds, and seen at a
-/// grazing angle the long crests across the line of sight ran to the
+/// resolves from 300 m up make a lattice of diamonds, and seen at a
+/// grazing angle the long crests across the line of sight run to the
 /// vanishing point as straight lines: more trains in more directions
 /// make short crests.
 pub const WAVE_COUNT: u32 = 40;

@@ -26,8 +26,8 @@ pub enum GpuError {
 /// CPU twin's once primary steps times shadow steps pass about 10,000
 /// (fair weather at 64x48: 0.1 levels at 512 x 20 and 1024 x 10, 1.3 at
 /// 1024 x 20, 11 at distant cloud bases; each lit sample also sums its
-/// shadow steps' weights in a loop). README, "Lavapipe at 1024 steps or
-/// more".
+/// shadow steps' weights in a loop). docs/gpu.md, "Lavapipe at 1024
+/// steps or more".
 pub const LLVMPIPE_LOOP_ITERATIONS: u32 = 65_535;
 
 /// A device and queue with what the renderer can use.

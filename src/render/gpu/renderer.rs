@@ -610,7 +610,7 @@ impl CloudRenderer {
     /// `None` while that size is zero).
     ///
     /// Each texel is linear and premultiplied: `rgb` the clouds' radiance
-    /// (sunlight of [`crate::render::cpu::renderer::SUN_INTENSITY`], no
+    /// (sunlight of [`crate::render::cpu::sky::SUN_INTENSITY`], no
     /// exposure and no tone map applied; the haze in front of the clouds
     /// included), `a` their opacity, one minus the transmittance. The
     /// engine's own colour `c` behind becomes `rgb + (1 - a) · c`; with

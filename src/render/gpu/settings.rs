@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::tsaa::TsaaSettings;
 use crate::render::cpu::density::DensityParams;
-use crate::render::cpu::renderer::Quality;
+use crate::render::cpu::frame::Quality;
 use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::sky_luts::SkyParams;
 
@@ -63,7 +63,7 @@ impl GpuSettings {
         sun_direction(self.sun_elevation_deg, self.sun_azimuth_deg)
     }
 
-    /// Values of the WGSL `override` constants (`shaders/clouds.wgsl`, and
+    /// Values of the WGSL `override` constants (`shaders/frame.wgsl`, and
     /// `LAND_FIELDS` in `shaders/land.wgsl`) for these settings: a feature
     /// that is off is compiled out.
     pub fn constants(&self) -> Vec<(&'static str, f64)> {

@@ -1,21 +1,55 @@
-//! WGSL sources, assembled per variant. `shaders/clouds.wgsl` holds the
-//! shared functions (the twins of `render::cpu`), `shaders/land.wgsl`
-//! (the land's albedo), then the sky model's
-//! file (`sky_analytic.wgsl`, or `sky_luts.wgsl` and `sky_physical.wgsl`
-//! with the atmosphere tables' bindings); each pass appends its own file,
-//! and the variant's bindings and entry point are appended here, so a
-//! feature a scene does not use has no binding, no output and no code.
+//! WGSL sources, assembled per variant. Each file under `shaders/` that
+//! holds shared functions is the twin of the Rust module of the same name
+//! (`density.wgsl` of `render::cpu::density`, and so on; `tests/shader_twins.rs`
+//! checks it function by function). [`CLOUDS`] is those files in one
+//! string; then `shaders/land.wgsl` (the land's albedo) and the sky
+//! model's file (`sky_analytic.wgsl`, or the sky tables and
+//! `sky_physical.wgsl` with the tables' bindings); each pass appends its
+//! own file, and the variant's bindings and entry point are appended here,
+//! so a feature a scene does not use has no binding, no output and no code.
 
-/// The shared functions and the frame uniform block.
-pub const CLOUDS: &str = include_str!("../../../shaders/clouds.wgsl");
-/// The composite pass.
-pub const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
+/// The shared functions of every pass: the frame's values and bindings,
+/// then the twins of `render::camera` and of `render::cpu`'s `density`,
+/// `lighting`, `sky`, `waves`, `sea`, `tone_map` and `renderer`.
+pub const CLOUDS: &str = concat!(
+    include_str!("../../../shaders/frame.wgsl"),
+    "\n",
+    include_str!("../../../shaders/camera.wgsl"),
+    "\n",
+    include_str!("../../../shaders/density.wgsl"),
+    "\n",
+    include_str!("../../../shaders/lighting.wgsl"),
+    "\n",
+    include_str!("../../../shaders/sky.wgsl"),
+    "\n",
+    include_str!("../../../shaders/waves.wgsl"),
+    "\n",
+    include_str!("../../../shaders/sea.wgsl"),
+    "\n",
+    include_str!("../../../shaders/tone_map.wgsl"),
+    "\n",
+    include_str!("../../../shaders/renderer.wgsl"),
+);
+/// The composite pass: its tone map and output (`composite.wgsl`, the
+/// twins of `render::cpu::tone_map`) and the sun's glare (`glare.wgsl`,
+/// of `render::cpu::glare`).
+pub const COMPOSITE: &str = concat!(
+    include_str!("../../../shaders/composite.wgsl"),
+    "\n",
+    include_str!("../../../shaders/glare.wgsl"),
+);
 /// The TSAA resolve pass.
 pub const TSAA: &str = include_str!("../../../shaders/tsaa.wgsl");
 /// The terrain pass.
 pub const TERRAIN: &str = include_str!("../../../shaders/terrain.wgsl");
 /// The sky tables' functions (a library: no bindings, no entry points).
-pub const SKY_LUTS: &str = include_str!("../../../shaders/sky_luts.wgsl");
+pub const SKY_LUTS: &str = concat!(
+    include_str!("../../../shaders/sky_luts/atmosphere.wgsl"),
+    "\n",
+    include_str!("../../../shaders/sky_luts/tables.wgsl"),
+    "\n",
+    include_str!("../../../shaders/sky_luts/lookups.wgsl"),
+);
 /// The sky tables' compute entry points (after [`SKY_LUTS`]).
 pub const SKY_LUTS_BUILD: &str = include_str!("../../../shaders/sky_luts_build.wgsl");
 /// What the spheroid and volume passes share (after [`COMPOSITE`]).
@@ -27,6 +61,10 @@ pub const SKY_ANALYTIC: &str = include_str!("../../../shaders/sky_analytic.wgsl"
 pub const SKY_PHYSICAL: &str = include_str!("../../../shaders/sky_physical.wgsl");
 /// The land's albedo, plain or fields and woods (after [`CLOUDS`]).
 pub const LAND: &str = include_str!("../../../shaders/land.wgsl");
+/// The spheroid renderer's pass (after [`COMPOSITE`] and [`STANDALONE`]).
+pub const SPHEROIDS: &str = include_str!("../../../shaders/spheroids.wgsl");
+/// The volume renderer's pass (after [`COMPOSITE`] and [`STANDALONE`]).
+pub const VOLUME: &str = include_str!("../../../shaders/volume.wgsl");
 
 /// The light volume's grid (after [`CLOUDS`]; each module that appends it
 /// declares `volume_grid`).
@@ -161,21 +199,13 @@ pub fn terrain_pass(physical: bool) -> String {
 /// The spheroid renderer's source (its bind group 0 holds the uniforms
 /// alone, so it draws under the analytic sky).
 pub fn spheroids_pass() -> String {
-    format!(
-        "{}{COMPOSITE}\n{STANDALONE}\n{}",
-        shared(false),
-        super::spheroids::SPHEROIDS
-    )
+    format!("{}{COMPOSITE}\n{STANDALONE}\n{}", shared(false), SPHEROIDS)
 }
 
 /// The volume renderer's source (bind group 0 the uniforms alone: the
 /// analytic sky).
 pub fn volume_pass() -> String {
-    format!(
-        "{}{COMPOSITE}\n{STANDALONE}\n{}",
-        shared(false),
-        super::volume_pass::VOLUME
-    )
+    format!("{}{COMPOSITE}\n{STANDALONE}\n{}", shared(false), VOLUME)
 }
 
 /// The light volume's build: its four compute entry points over group 0

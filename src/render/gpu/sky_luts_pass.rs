@@ -1,5 +1,5 @@
-//! The sky tables of `render::cpu::sky_luts` built on the GPU: three
-//! compute passes (`shaders/sky_luts.wgsl`) into `Rgba32Float` storage
+//! The sky tables of `render::cpu::sky_luts` built on the GPU: four
+//! compute passes (`shaders/sky_luts_build.wgsl`) into `Rgba32Float` storage
 //! textures of the CPU tables' sizes. The transmittance and
 //! multiple-scattering tables are rebuilt only when the [`SkyParams`]
 //! change, the sky view only when they or its inputs (the sun's elevation,
@@ -137,7 +137,7 @@ fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
     )
 }
 
-/// Bindings 0..n of `shaders/sky_luts.wgsl`: params, the table written,
+/// Bindings 0..n of `shaders/sky_luts_build.wgsl`: params, the table written,
 /// the transmittance table, the multiple-scattering table, the sky view's
 /// inputs. Each pass binds a prefix.
 fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 6] {

@@ -17,9 +17,6 @@ use crate::render::cpu::sky::sun_direction;
 use crate::render::cpu::spheroids::LightGrid;
 pub use crate::render::cpu::spheroids::Spheroid;
 
-/// The spheroid renderer's WGSL.
-pub const SPHEROIDS: &str = include_str!("../../../shaders/spheroids.wgsl");
-
 /// The spheroid renderer: one full-screen pass straight into the target.
 pub struct SpheroidRenderer {
     device: wgpu::Device,

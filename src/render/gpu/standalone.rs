@@ -59,7 +59,7 @@ impl StandalonePass {
             queue,
             settings.quality.land_fields.then_some(noise),
         );
-        // The WGSL's bindings 4 and 5 of group 0 (clouds.wgsl's
+        // The WGSL's bindings 4 and 5 of group 0 (frame.wgsl's
         // wrap_linear and noise_tex), not the next free ones.
         let noise_view = bind::view(&land_noise);
         let group0 = device.create_bind_group(&wgpu::BindGroupDescriptor {

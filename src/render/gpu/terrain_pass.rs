@@ -14,9 +14,9 @@ pub const PASS_TERRAIN: &str = "terrain";
 /// The most vertices the terrain pass draws a frame. The heightfield's
 /// mesh (`size²` cells) is drawn once per tile out to the longest ray,
 /// `(2R + 1)²` tiles for `R = ⌈max_distance / extent⌉`: the default
-/// terrain (256², 20 km, 40 km) is 9.8 M vertices, but 1 km tiles made
-/// 2.6 G (6561 tiles) and 1 m tiles 2.5·10¹⁵ (6.4·10⁹ tiles, past a
-/// `u32`), and lavapipe's frame never ended. Beyond
+/// terrain (256², 20 km, 40 km) is 9.8 M vertices, but 1 km tiles would
+/// make 2.6 G (6561 tiles) and 1 m tiles 2.5·10¹⁵ (6.4·10⁹ tiles, past a
+/// `u32`), and lavapipe's frame would never end. Beyond
 /// this budget (16.8 M, 1.7 times the default's) each tile's mesh takes
 /// every `s`-th height ([`mesh_stride`]).
 pub const TERRAIN_VERTEX_BUDGET: u64 = 16 << 20;

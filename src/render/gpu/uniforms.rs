@@ -5,13 +5,14 @@ use glam::{Mat4, Vec3};
 
 use crate::render::camera::View;
 use crate::render::cpu::density::DensityParams;
-use crate::render::cpu::renderer::{Quality, SUN_INTENSITY};
+use crate::render::cpu::frame::Quality;
+use crate::render::cpu::sky::SUN_INTENSITY;
 use crate::render::cpu::sky::{sun_color, sun_direction};
 use crate::render::cpu::sky_luts::SkyParams;
 #[cfg(doc)]
 use crate::render::cpu::sky_luts::radius_at_altitude;
 
-// Keep in sync with shaders/clouds.wgsl: Frame.
+// Keep in sync with shaders/frame.wgsl: Frame.
 /// Everything the passes read per frame; one `vec4` per line of the WGSL
 /// struct (the meaning of each lane is in the shader).
 #[repr(C)]
@@ -124,7 +125,7 @@ impl FrameUniforms {
     }
 }
 
-// Keep in sync with shaders/sky_luts.wgsl: SkyParams.
+// Keep in sync with shaders/sky_luts/atmosphere.wgsl: SkyParams.
 /// [`SkyParams`] as the sky tables' WGSL reads it: each `vec3f` shares its
 /// 16 bytes with the scalar after it; 88 bytes of members, 96 in all.
 #[repr(C)]
@@ -173,7 +174,7 @@ impl SkyParamsUniforms {
     }
 }
 
-// Keep in sync with shaders/sky_luts.wgsl: SkyView.
+// Keep in sync with shaders/sky_luts/atmosphere.wgsl: SkyView.
 /// The sky view's inputs besides [`SkyParams`]: the camera's radius (km,
 /// [`radius_at_altitude`]) and the sun's cos zenith.
 #[repr(C)]

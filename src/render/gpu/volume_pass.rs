@@ -13,9 +13,6 @@ use crate::render::camera::Camera;
 use crate::render::cpu::volume::{VolumeParams, VolumeStack};
 use crate::render::noise_volume::NoiseVolume;
 
-/// The volume renderer's WGSL.
-pub const VOLUME: &str = include_str!("../../../shaders/volume.wgsl");
-
 /// The volume renderer.
 pub struct VolumeRenderer {
     queue: wgpu::Queue,

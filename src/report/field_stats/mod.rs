@@ -22,7 +22,7 @@ pub use repetition::{Lag, Repetition, correlation, repetition};
 pub use write::{write, write_optical_depth, write_optical_depth_as, write_repetition};
 
 use crate::render::cpu::density::density_at;
-use crate::render::cpu::renderer::Frame;
+use crate::render::cpu::frame::Frame;
 
 /// A cloud mask on a periodic `width x height` grid of square cells.
 #[derive(Debug, Clone, PartialEq)]

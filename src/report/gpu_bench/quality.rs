@@ -3,7 +3,7 @@
 
 use super::{BenchError, BenchOptions, Knob, QualityRow};
 use crate::prepare::Prepared;
-use crate::render::cpu::renderer::supersampled_srgb8;
+use crate::render::cpu::stills::supersampled_srgb8;
 use crate::render::gpu::{GpuContext, GpuError};
 use crate::scene::{RenderSettings, Scene};
 

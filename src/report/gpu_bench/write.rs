@@ -162,8 +162,8 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
         .collect();
     // The defaults, one ring each; those within 10 % of an earlier one in
     // time and error (the same settings, measured in each knob's sweep)
-    // share its ring and label, whose three labels were drawn over each
-    // other.
+    // share its ring and label, so that one setting's three labels are
+    // not drawn over each other.
     let mut marked: Vec<(f64, f64, String)> = Vec::new();
     for q in report.quality.iter().filter(|q| q.is_default) {
         let (ms, error) = (q.ms.max(1e-6), q.mean_error.max(1e-6));

@@ -311,10 +311,10 @@ pub const SKY_AMBIENT_SIZE: (u32, u32) = (1, 1);
 /// What lights the ground, and a cloud through its top, from the whole
 /// sky, including the bright aureole around the sun at its true (small)
 /// solid angle, which a handful of fixed directions would over- or
-/// under-weight. The cosine matters under a low sun: the uniform mean
-/// (used until 2026-12-03) weighted the red glow around the sun at the
-/// horizon as much as the blue zenith, and the path tracer's cloud bases
-/// are as blue as the cosine-weighted sky (docs/ground_truth).
+/// under-weight. The cosine matters under a low sun: a uniform mean
+/// weights the red glow around the sun at the horizon as much as the
+/// blue zenith, and the path tracer's cloud bases are as blue as the
+/// cosine-weighted sky (docs/ground_truth/compare.py).
 pub fn sky_ambient_texel(sky_view: &Lut2, r: f32, p: &SkyParams) -> Vec3 {
     let (rows, columns) = SKY_AMBIENT_SAMPLES;
     let mut sum = Vec3::ZERO;

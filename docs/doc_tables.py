@@ -1,13 +1,13 @@
-"""Rewrites the README's tables of numbers from what docs/regenerate.sh made.
+"""Rewrites the docs' tables of numbers from what docs/regenerate.sh made.
 
-    python3 docs/readme_tables.py STATS_DIR
+    python3 docs/doc_tables.py STATS_DIR
 
-- "Error against cost (rendering)": docs/render_quality/render_quality.csv
+- docs/renderer.md "Error against cost (rendering)": docs/render_quality/render_quality.csv
   (its rows of 8, 16, 32, 48, 64, 96, 128 and 256 steps; the default, 48, bold);
-- "Error against run time (physics)": docs/convergence/convergence.csv (its
+- docs/physics.md "Error against run time (physics)": docs/convergence/convergence.csv (its
   rows of dt 0.1, 0.5, 1, 2, 5, 10, 60 and 600 s; the default, 5 s, bold);
-- "Cloud-field statistics": the `cumulus stats` output saved as
-  STATS_DIR/NAME.txt for fair_weather and bomex.
+- the cloud-field statistics tables of README.md and docs/physics.md: the
+  `cumulus stats` output saved as STATS_DIR/NAME for fair_weather and bomex.
 
 Only the rows of those tables change; the text around them is left alone
 (say in it what changed). tests/docs_numbers.rs checks the result.
@@ -104,18 +104,28 @@ def stats_rows(stats_dir):
     return out
 
 
-def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: python3 docs/readme_tables.py STATS_DIR")
-    path = ROOT / "README.md"
+def rewrite(name, tables):
+    """Replaces the tables of ROOT/name, (marker, rows) each, atomically."""
+    path = ROOT / name
     text = path.read_text()
-    text = replace_table(text, "### Error against cost (rendering)", render_quality_rows())
-    text = replace_table(text, "## Error against run time (physics)", convergence_rows())
-    text = replace_table(text, "Today's fields (", stats_rows(sys.argv[1]))
+    for marker, rows in tables:
+        text = replace_table(text, marker, rows)
     tmp = path.with_suffix(".md.tmp")
     tmp.write_text(text)
     tmp.replace(path)
-    print("README.md: tables rewritten")
+    print(f"{name}: tables rewritten")
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: python3 docs/doc_tables.py STATS_DIR")
+    stats = stats_rows(sys.argv[1])
+    rewrite("docs/renderer.md", [("### Error against cost (rendering)", render_quality_rows())])
+    rewrite(
+        "docs/physics.md",
+        [("## Error against run time (physics)", convergence_rows()), ("Today's fields (", stats)],
+    )
+    rewrite("README.md", [("The field statistics of the shipped scenes", stats)])
 
 
 if __name__ == "__main__":
