@@ -9,10 +9,11 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use cumulus::endless::distances;
 use cumulus::prepare::Prepared;
 use cumulus::render::cloud_map::{CloudMap, CloudMapConfig};
-use cumulus::render::cpu::light_transport::trace;
-use cumulus::render::cpu::light_volume::{
-    LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons, sh_planes,
+use cumulus::render::cpu::light_grid::{
+    LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons,
 };
+use cumulus::render::cpu::light_transport::trace;
+use cumulus::render::cpu::light_volume::sh_planes;
 use cumulus::render::cpu::sky::sun_direction;
 use cumulus::render::cpu::stills::render_linear;
 use cumulus::render::soft_field::{SPREAD_M, soft_field};

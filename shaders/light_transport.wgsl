@@ -1,6 +1,6 @@
 // The sunlight's Monte Carlo transport on the light grid: the twin of
 // src/render/cpu/light_transport.rs (same names; the same random numbers
-// for the same photon and seed). Appended after light_volume.wgsl;
+// for the same photon and seed). Appended after light_grid.wgsl;
 // `follow` reads the cells' extinction (`light_cells`) and adds its
 // tracks to `light_tracks`, fixed point (TRACK_UNIT metres), which
 // light_volume_build.wgsl declares.

@@ -1,8 +1,8 @@
 // The light volume's build: four compute entry points, the twins of the
 // CPU's `cell_extinction`, `trace` and `sh_planes`
-// (src/render/cpu/light_volume.rs, light_transport.rs), and the folding of
+// (src/render/cpu/light_grid.rs, light_volume.rs, light_transport.rs), and the folding of
 // each batch's fixed-point tracks into floats. Appended after CLOUDS
-// (density.wgsl's `density_at` reads group 0), light_volume.wgsl and
+// (density.wgsl's `density_at` reads group 0), light_grid.wgsl and
 // light_transport.wgsl.
 //
 // `light_step` (a dynamic offset into one buffer) says which photons a

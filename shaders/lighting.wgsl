@@ -167,3 +167,27 @@ fn integrate_step(s: vec3f, sigma_t: f32, dt: f32) -> vec3f {
     }
     return (s - s * exp(-sigma_t * dt)) / sigma_t;
 }
+
+// The sky's and the ground's light scattered at height fraction `eta`
+// (the CPU's `ambient_light`): the sky's from 0.35 at the band's bottom
+// to all at its top, the ground's from all at the bottom to none at the top.
+fn ambient_light(sky_top: vec3f, ground: vec3f, eta: f32) -> vec3f {
+    let gains = light_gains();
+    return sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground);
+}
+
+const GROUND_SHADOW_FOOTPRINT_M: f32 = 6.0;
+
+fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
+    let seg = band_segment(p, sun_dir, frame.band.x, frame.band.y, 20000.0);
+    if seg.y <= seg.x {
+        return 1.0;
+    }
+    let n = max(steps, 1u);
+    let dt = (seg.y - seg.x) / f32(n);
+    var tau = 0.0;
+    for (var i = 0u; i < n; i++) {
+        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), true, GROUND_SHADOW_FOOTPRINT_M) * dt;
+    }
+    return exp(-tau);
+}

@@ -9,7 +9,6 @@ const NEAR_M: f32 = 3000.0;
 // steps, at most MARCH_STEP_FACTOR_MAX times (march_step_count).
 const MARCH_LOG_SPAN: f32 = 0.35;
 const MARCH_STEP_FACTOR_MAX: f32 = 4.0;
-const GROUND_SHADOW_FOOTPRINT_M: f32 = 6.0;
 const BLUE_NOISE_SIZE: u32 = 64u;
 
 // Samples of the clouds' shadow on the ground (the CPU's renderer.rs).
@@ -17,28 +16,6 @@ const GROUND_SHADOW_STEPS: u32 = 12u;
 
 // The golden ratio's fraction (the CPU's sampling::GOLDEN).
 const GOLDEN: f32 = 0.618034;
-
-// The sky's and the ground's light scattered at height fraction `eta`
-// (the CPU's `ambient_light`): the sky's from 0.35 at the band's bottom
-// to all at its top, the ground's from all at the bottom to none at the top.
-fn ambient_light(sky_top: vec3f, ground: vec3f, eta: f32) -> vec3f {
-    let gains = light_gains();
-    return sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground);
-}
-
-fn cloud_shadow(p: vec3f, sun_dir: vec3f, steps: u32) -> f32 {
-    let seg = band_segment(p, sun_dir, frame.band.x, frame.band.y, 20000.0);
-    if seg.y <= seg.x {
-        return 1.0;
-    }
-    let n = max(steps, 1u);
-    let dt = (seg.y - seg.x) / f32(n);
-    var tau = 0.0;
-    for (var i = 0u; i < n; i++) {
-        tau += density_at(p + sun_dir * (seg.x + (f32(i) + 0.5) * dt), true, GROUND_SHADOW_FOOTPRINT_M) * dt;
-    }
-    return exp(-tau);
-}
 
 // The clouds' shadow where a ray that meets no terrain reaches the flat
 // ground (the CPU's `flat_ground_shadow`).

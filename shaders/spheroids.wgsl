@@ -206,13 +206,8 @@ fn march_spheroids(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
     let sun_dir = frame.sun_dir.xyz;
     let steps = max(frame.counts.x, 1u);
     let dt = total / f32(steps);
-    let cos_theta = dot(dir, sun_dir);
-    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
-    let sky_top = sky_ambient(sun_dir) * 0.25;
-    let ground = ground_up(sun_dir, SEA) * 0.25;
-    var transmittance = 1.0;
-    var light = vec3f(0.0);
-    var depth_weighted = 0.0;
+    let l = standalone_light(dir, sun_dir);
+    var march = StandaloneMarch(vec3f(0.0), 1.0, 0.0);
     var seg = 0u;
     var before = 0.0; // merged length before segment `seg`
     for (var i = 0u; i < steps; i++) {
@@ -232,18 +227,11 @@ fn march_spheroids(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
             continue;
         }
         let tau_sun = light_grid_depth(p);
-        let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let ambient = ambient_light(sky_top, ground, eta);
-        let src = (sun * sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + ambient) * (sigma_t * ALBEDO);
-        let step_t = exp(-sigma_t * dt);
-        light += integrate_step(src, sigma_t, dt) * transmittance;
-        depth_weighted += t * transmittance * (1.0 - step_t);
-        transmittance *= step_t;
-        if transmittance < MIN_TRANSMITTANCE {
+        if standalone_step(&march, l, p, t, dt, sigma_t, tau_sun) {
             break;
         }
     }
-    return hazed_clouds(light, transmittance, depth_weighted, dir, sun_dir);
+    return hazed_clouds(march, dir, sun_dir);
 }
 
 @fragment

@@ -91,13 +91,8 @@ fn march_volume(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
     let sun_dir = frame.sun_dir.xyz;
     let log_ratio = log((seg.y + NEAR_M) / (t0 + NEAR_M));
     let steps = march_step_count(frame.counts.x, log_ratio);
-    let cos_theta = dot(dir, sun_dir);
-    let sun = sun_light_at(0.5 * (frame.band.x + frame.band.y), sun_dir);
-    let sky_top = sky_ambient(sun_dir) * 0.25;
-    let ground = ground_up(sun_dir, SEA) * 0.25;
-    var transmittance = 1.0;
-    var light = vec3f(0.0);
-    var depth_weighted = 0.0;
+    let l = standalone_light(dir, sun_dir);
+    var march = StandaloneMarch(vec3f(0.0), 1.0, 0.0);
     for (var i = 0u; i < steps; i++) {
         let ta = march_distance(t0, log_ratio, f32(i) / f32(steps));
         let tb = march_distance(t0, log_ratio, f32(i + 1u) / f32(steps));
@@ -110,18 +105,11 @@ fn march_volume(origin: vec3f, dir: vec3f, dither: f32) -> vec4f {
         }
         let length = min(shadow_ray_length(p, sun_dir), VOLUME_SHADOW_RAY_M);
         let tau_sun = volume_optical_depth(p, sun_dir, length);
-        let eta = clamp((p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
-        let ambient = ambient_light(sky_top, ground, eta);
-        let src = (sun * sun_scattering(tau_sun, cos_theta, sun_dir.y, sigma_t) + ambient) * (sigma_t * ALBEDO);
-        let step_t = exp(-sigma_t * dt);
-        light += integrate_step(src, sigma_t, dt) * transmittance;
-        depth_weighted += t * transmittance * (1.0 - step_t);
-        transmittance *= step_t;
-        if transmittance < MIN_TRANSMITTANCE {
+        if standalone_step(&march, l, p, t, dt, sigma_t, tau_sun) {
             break;
         }
     }
-    return hazed_clouds(light, transmittance, depth_weighted, dir, sun_dir);
+    return hazed_clouds(march, dir, sun_dir);
 }
 
 @fragment

@@ -1,4 +1,5 @@
-// The sea's wave trains; the twins of src/render/cpu/waves.rs.
+// The sea's wave trains and the rays they reflect; the twins of
+// src/render/cpu/waves.rs.
 
 // The sea's wave trains (the CPU's waves.rs): how many, the octaves of
 // wavelength they span, the longest's wavelength (m), their directions' spread about the wind (radians), the
@@ -82,20 +83,6 @@ fn sea_waves(x: f32, z: f32, dir: vec3f, spread: f32, t: f32, wind_mps: f32, tow
     return vec3f(slope, max(total - resolved, 1e-4));
 }
 
-// The waves where the ray meets the sea; the flat sea where it looks up,
-// the eye is under the sea or the sea lies beyond the rays' reach (the
-// CPU's `sea_waves_at`; only with SEA).
-fn sea_waves_at(origin: vec3f, dir: vec3f) -> vec3f {
-    if !SEA || dir.y >= 0.0 || origin.y <= 0.0 {
-        return flat_sea(SEA_WIND_MPS);
-    }
-    let t = origin.y / -dir.y;
-    if t > frame.sun_light.w {
-        return flat_sea(SEA_WIND_MPS);
-    }
-    return sea_waves(origin.x + dir.x * t, origin.z + dir.z * t, dir, frame.cam_pos.w, t, SEA_WIND_MPS, SEA_WIND_TOWARD_DEG, frame.terrain.z);
-}
-
 // No resolved slope, all of Cox and Munk's variance (the CPU's
 // `flat_sea`).
 fn flat_sea(wind_mps: f32) -> vec3f {
@@ -105,4 +92,40 @@ fn flat_sea(wind_mps: f32) -> vec3f {
 // The sea's normal under the resolved waves (the CPU's `wave_normal`).
 fn wave_normal(waves: vec3f) -> vec3f {
     return normalize(vec3f(-waves.x, 1.0, -waves.y));
+}
+
+// The lowest elevation (radians) a wave sends a reflected ray to (the
+// CPU's waves.rs).
+const REFLECTION_MIN_ELEVATION: f32 = 0.01;
+
+// The elevation (radians) of a ray the wind-roughened sea reflects where
+// the resolved waves' mirror ray rises at `mirror`, at the quantile `u` of
+// the unresolved slopes (mean square `variance`): a logistic of their
+// deviation, cut off below REFLECTION_MIN_ELEVATION (the CPU's
+// `reflected_elevation`).
+fn reflected_elevation(mirror: f32, variance: f32, u: f32) -> f32 {
+    let deviation = sqrt(2.0 * max(variance, 0.0));
+    let s = deviation * sqrt(3.0) / PI;
+    let lowest = 1.0 / (1.0 + exp((mirror - REFLECTION_MIN_ELEVATION) / s));
+    let q = clamp(lowest + (1.0 - lowest) * u, 1e-6, 1.0 - 1e-6);
+    return mirror + s * log(q / (1.0 - q));
+}
+
+// A wave's slope across the line of sight at the quantile `u`: a logistic
+// of the unresolved slopes' deviation in one direction (the CPU's
+// `cross_slope`).
+fn cross_slope(variance: f32, u: f32) -> f32 {
+    let deviation = sqrt(0.5 * max(variance, 0.0));
+    let s = deviation * sqrt(3.0) / PI;
+    let q = clamp(u, 1e-6, 1.0 - 1e-6);
+    return s * log(q / (1.0 - q));
+}
+
+// The ray a wave sends up from the sea, seen along a ray falling at
+// `mirror` radians along `across`: rising at elevation `e`, turned
+// sideways by `slope (sin(mirror) + sin(e))` (the CPU's `reflected_ray`).
+fn reflected_ray(across: vec3f, mirror: f32, e: f32, slope: f32) -> vec3f {
+    let side = vec3f(-across.z, 0.0, across.x);
+    let sideways = slope * (sin(mirror) + sin(e));
+    return normalize(across * cos(e) + side * sideways + vec3f(0.0, sin(e), 0.0));
 }

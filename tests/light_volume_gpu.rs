@@ -57,8 +57,8 @@ const PROGRESSIVE_REL: f64 = 0.03;
 
 #[test]
 fn the_gpu_light_volume_is_its_cpu_twin() {
+    use cumulus::render::cpu::light_grid::{LIGHT_SEED, cell_extinction, light_photons};
     use cumulus::render::cpu::light_transport::{PHASE_MOMENTS, SH_BAND, trace};
-    use cumulus::render::cpu::light_volume::{LIGHT_SEED, cell_extinction, light_photons};
     use cumulus::render::cpu::sky::sun_direction;
     let Some(ctx) = gpu() else { return };
     for name in ["fair_weather", "bomex"] {

@@ -13,16 +13,17 @@ use cumulus::render::cpu::lighting::{
     sun_transmittance,
 };
 use cumulus::render::cpu::renderer::{flat_ground_shadow, march_ray};
-use cumulus::render::cpu::sea::{
-    REFLECTION_MIN_ELEVATION, ReflectionLight, cross_slope, reflected_clouds, reflected_elevation,
-    reflected_ray, sea_reflection,
-};
+use cumulus::render::cpu::sea::sea_waves_at;
+use cumulus::render::cpu::sea::{ReflectionLight, reflected_clouds, sea_reflection};
 use cumulus::render::cpu::sky::{
     AtmosphereConfig, LAND_ALBEDO, SkyModel, background_radiance, sun_direction, sun_light_at,
 };
 use cumulus::render::cpu::stills::render_linear;
 use cumulus::render::cpu::tone_map::to_srgb8;
-use cumulus::render::cpu::waves::{flat_sea, sea_waves_at, slope_variance};
+use cumulus::render::cpu::waves::{
+    REFLECTION_MIN_ELEVATION, cross_slope, reflected_elevation, reflected_ray,
+};
+use cumulus::render::cpu::waves::{flat_sea, slope_variance};
 use cumulus::sim::ProjectedField;
 use glam::Vec3;
 

@@ -14,7 +14,7 @@ use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
 use cumulus::render::cpu::{
-    density, frame, glare, land, light_transport, light_volume, lighting, renderer, sea, sky,
+    density, frame, glare, land, light_grid, light_transport, lighting, renderer, sea, sky,
     sky_luts, waves,
 };
 use cumulus::render::gpu::light_volume_pass::{self, LightVolumeGridUniforms};
@@ -136,7 +136,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("FINE_SHARP_M", density::FINE_SHARP_M as f64),
         (
             "GROUND_SHADOW_FOOTPRINT_M",
-            renderer::GROUND_SHADOW_FOOTPRINT_M as f64,
+            lighting::GROUND_SHADOW_FOOTPRINT_M as f64,
         ),
         ("NOISE_MAX_LOD", density::NOISE_MAX_LOD as f64),
         ("NOISE_SIZE", cumulus::render::noise_volume::SIZE as f64),
@@ -220,7 +220,7 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ("REFLECTION_STEP_M", sea::REFLECTION_STEP_M as f64),
         (
             "REFLECTION_MIN_ELEVATION",
-            sea::REFLECTION_MIN_ELEVATION as f64,
+            waves::REFLECTION_MIN_ELEVATION as f64,
         ),
         ("GOLDEN", cumulus::render::sampling::GOLDEN as f64),
         ("WAVE_COUNT", waves::WAVE_COUNT as f64),
@@ -239,8 +239,8 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
         ),
         ("SKY_AMBIENT_ROWS", sky_luts::SKY_AMBIENT_SAMPLES.0 as f64),
         ("FLUENCE_GAIN", lighting::FLUENCE_GAIN as f64),
-        ("LIGHT_SUN_MIN", light_volume::LIGHT_SUN_MIN as f64),
-        ("LIGHT_SEED", light_volume::LIGHT_SEED as f64),
+        ("LIGHT_SUN_MIN", light_grid::LIGHT_SUN_MIN as f64),
+        ("LIGHT_SEED", light_grid::LIGHT_SEED as f64),
         (
             "CELLS_PER_PHOTON_MAX",
             light_transport::CELLS_PER_PHOTON_MAX as f64,
@@ -465,7 +465,7 @@ const MIRRORS: &[(&str, &[&str])] = &[
     ("glare.wgsl", &["src/render/cpu/glare.rs"]),
     ("renderer.wgsl", &["src/render/cpu/renderer.rs"]),
     ("land.wgsl", &["src/render/cpu/land.rs"]),
-    ("light_volume.wgsl", &["src/render/cpu/light_volume.rs"]),
+    ("light_grid.wgsl", &["src/render/cpu/light_grid.rs"]),
     (
         "light_transport.wgsl",
         &["src/render/cpu/light_transport.rs"],

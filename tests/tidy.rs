@@ -3,6 +3,7 @@
 //! line that breaks its rule. Comments are not code: lines starting with
 //! `//` are skipped.
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// Every `.rs` file under `src/<dir>`, with its code lines (line number,
@@ -286,4 +287,102 @@ fn no_dated_narrative_outside_the_changelog() {
          beside a figure):\n{}",
         bad.join("\n")
     );
+}
+
+/// The sibling modules each file of `src/<dir>` imports (`super::name`
+/// on a code line before its tests), by module name; `*_tests.rs` files
+/// and a folder's `mod.rs` left out.
+fn sibling_imports(dir: &str) -> std::collections::BTreeMap<String, Vec<String>> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(dir);
+    let mut out = std::collections::BTreeMap::new();
+    for e in std::fs::read_dir(&root).expect("read_dir") {
+        let p = e.expect("entry").path();
+        let name = p.file_stem().map(|s| s.to_string_lossy().into_owned());
+        let Some(name) = name else { continue };
+        let module = if p.is_dir() {
+            p.join("mod.rs")
+        } else {
+            p.clone()
+        };
+        if name == "mod" || name.ends_with("tests") || !module.exists() {
+            continue;
+        }
+        let text = std::fs::read_to_string(&module).expect("read");
+        let mut deps = Vec::new();
+        for line in text.lines() {
+            if line.starts_with("#[cfg(test)]") {
+                break;
+            }
+            if line.trim_start().starts_with("//") {
+                continue;
+            }
+            for part in line.split("super::").skip(1) {
+                let dep: String = part
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                    .collect();
+                if !dep.is_empty() && dep != "super" && !deps.contains(&dep) {
+                    deps.push(dep);
+                }
+            }
+        }
+        out.insert(name, deps);
+    }
+    out
+}
+
+/// A circle of imports among `graph`'s modules, if there is one.
+fn circle(graph: &std::collections::BTreeMap<String, Vec<String>>) -> Option<Vec<String>> {
+    fn visit(
+        m: &str,
+        graph: &std::collections::BTreeMap<String, Vec<String>>,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(i) = path.iter().position(|p| p == m) {
+            return Some(path[i..].to_vec());
+        }
+        if done.contains(m) {
+            return None;
+        }
+        path.push(m.to_string());
+        for d in graph.get(m).into_iter().flatten() {
+            if graph.contains_key(d)
+                && let Some(c) = visit(d, graph, path, done)
+            {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(m.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    graph
+        .keys()
+        .find_map(|m| visit(m, graph, &mut Vec::new(), &mut done))
+}
+
+/// The renderer's files import each other in layers (ARCHITECTURE.md):
+/// no two files of `render/`, `render/cpu/` or `render/gpu/` reach each
+/// other through their imports.
+#[test]
+fn render_modules_import_each_other_without_a_circle() {
+    for dir in ["render", "render/cpu", "render/gpu"] {
+        let graph = sibling_imports(dir);
+        assert!(graph.len() > 5, "{dir}: {graph:?}");
+        if let Some(c) = circle(&graph) {
+            panic!("src/{dir}: a circle of imports: {}", c.join(" -> "));
+        }
+    }
+}
+
+/// Nothing below the reports reaches up into them: the endless player and
+/// the renderer take what they share from `render`, not from `report`.
+#[test]
+fn endless_and_render_do_not_import_report() {
+    let o = offences("endless", |_| false, |l| l.contains("crate::report"));
+    assert!(o.is_empty(), "endless/ imports report:\n{}", o.join("\n"));
+    let o = offences("render", |_| false, |l| l.contains("crate::report"));
+    assert!(o.is_empty(), "render/ imports report:\n{}", o.join("\n"));
 }

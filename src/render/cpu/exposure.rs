@@ -14,6 +14,7 @@ use glam::Vec3;
 
 use super::sky::{AtmosphereConfig, SkyLight, SkyModel, sky_ambient, sun_direction, sun_light_at};
 use super::sky_luts::SkyLuts;
+use super::tone_map::luminance;
 
 /// The sun's elevation, degrees, at and above which the exposure is
 /// `render.exposure` itself (every shipped scene's sun is higher); below
@@ -31,12 +32,6 @@ pub const AUTO_EXPOSURE_POWER: f32 = 0.8;
 /// The most the metered exposure multiplies `render.exposure` by: 2^20,
 /// 20 stops (a sun 10° below the horizon asks for 12.7).
 pub const AUTO_EXPOSURE_MAX: f32 = 1_048_576.0;
-
-/// Rec. 709 luminance of a linear sRGB colour.
-#[inline]
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
 
 /// The illuminance of level ground under the clear sky (its luminance, in
 /// the renderer's radiance units): the sky's cosine-weighted mean

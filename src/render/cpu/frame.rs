@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::density::{DensityParams, Fields};
 use super::light_volume::LightVolume;
+use super::lighting::LightGains;
 use super::sky::{AtmosphereConfig, SkyLight, ground_cloud_light, sun_direction};
 use super::sky_luts::SkyLuts;
 use crate::render::camera::View;
@@ -106,5 +107,20 @@ impl Frame<'_> {
         let middle = 0.5 * (self.density.band_bottom_m + self.density.band_top_m);
         sky.ground_cloud_light = ground_cloud_light(&sky, sun_dir, self.cloud_cover, middle);
         sky
+    }
+}
+
+/// The light volume's transported sunlight at `p` scattered toward the
+/// eye (`to_eye`, against the ray), per unit scattering coefficient and
+/// sun irradiance ([`super::light_volume::LightVolume::light_toward`] times the transport's
+/// gain, [`super::lighting::FLUENCE_GAIN`]): 0 without one or without multiple scattering
+/// (`octaves` 0).
+#[inline]
+pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
+    match fr.light {
+        Some(v) if octaves > 0 => {
+            LightGains::TRANSPORT.fluence * v.light_toward(p, to_eye, fr.density.map_extent_m)
+        }
+        _ => 0.0,
     }
 }

@@ -21,9 +21,9 @@ use std::f32::consts::PI;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::exposure::luminance;
-use super::light_volume::{LIGHT_SUN_MIN, LightVolumeGrid};
+use super::light_grid::{LIGHT_SUN_MIN, LightVolumeGrid};
 use super::lighting::{ALBEDO, sh9};
+use super::tone_map::luminance;
 
 /// A photon's random numbers: a 32-bit PCG stream (O'Neill's RXS-M-XS
 /// output), seeded per photon; 32 bits so that WGSL draws the same

@@ -3,7 +3,9 @@
 //! itself is checked against theory in `light_transport.rs`.
 
 use super::*;
+use crate::render::cpu::light_grid::LIGHT_CELLS_MAX;
 use crate::render::cpu::light_transport::{sh_fluence, sh_flux};
+use glam::UVec3;
 
 /// The cells' extinction of a 1 km ball of cloud (0.03/m) around
 /// `centre`, clear air elsewhere.

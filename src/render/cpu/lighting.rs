@@ -6,7 +6,9 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::density::{DensityParams, Fields, density_at, height_fraction, smoothstep};
+use super::density::{
+    DensityParams, FINE_SHARP_M, Fields, band_segment, density_at, height_fraction, smoothstep,
+};
 use crate::render::sampling::GOLDEN;
 
 /// Henyey-Greenstein phase function, 1/sr; integrates to 1 over the sphere.
@@ -396,7 +398,7 @@ pub const ALBEDO: f32 = 0.99;
 /// The gain on the sky's light in cloud (`AMBIENT_GAIN` in WGSL):
 /// isotropic scattering of the upper sky's irradiance (`sky_above(up) /
 /// 4`), 0.35 of it at the band's bottom and all of it at its top
-/// ([`super::renderer::ambient_light`]), times this, which stands for that light's own
+/// ([`super::lighting::ambient_light`]), times this, which stands for that light's own
 /// multiple scattering; fitted with the octaves and the transported
 /// sunlight ([`sun_scattering`], [`FLUENCE_GAIN`]) and
 /// [`GROUND_LIGHT_GAIN`] (docs/ground_truth/fit_tops.py).
@@ -408,7 +410,7 @@ pub const AMBIENT_GAIN_ALONE: f32 = 4.37;
 /// The gain on the ground's light in cloud (`GROUND_LIGHT_GAIN` in
 /// WGSL): isotropic scattering of the ground's upward irradiance
 /// (`ground_up / 4`), all of it at the band's bottom and none at its top
-/// ([`super::renderer::ambient_light`]), times this. It is 0 beside the
+/// ([`super::lighting::ambient_light`]), times this. It is 0 beside the
 /// transported sunlight, which reaches the bases through the clouds as
 /// the path tracer's does: the fit (docs/ground_truth/fit_tops.py) puts
 /// it at 0 or within 0.011 of it, where no view's error moves by more
@@ -436,6 +438,43 @@ pub fn sh9(d: Vec3) -> [f32; 9] {
         1.092_548_4 * x * z,
         0.546_274_2 * (x * x - y * y),
     ]
+}
+
+/// The sky's and the ground's light scattered at height fraction `eta` of
+/// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4`, weighted
+/// from 0.35 at the bottom to 1 at the top, times the `gains`' `ambient`
+/// ([`super::lighting::AMBIENT_GAIN`] beside the light volume), and the ground's `ground /
+/// 4`, weighted from 1 at the bottom to 0 at the top, times their
+/// `ground` ([`super::lighting::GROUND_LIGHT_GAIN`]).
+#[inline]
+pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32, gains: &LightGains) -> Vec3 {
+    sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground)
+}
+
+/// The footprint the ground's cloud shadows read the density at, m
+/// (`GROUND_SHADOW_FOOTPRINT_M` in WGSL): twice
+/// [`super::density::FINE_SHARP_M`], so they read no fine billows (12
+/// samples across the band would only alias them), and at the default
+/// detail scale the finest mip level of everything else.
+pub const GROUND_SHADOW_FOOTPRINT_M: f32 = 2.0 * FINE_SHARP_M;
+
+/// Transmittance of the cloud band from a ground point `p` toward the sun:
+/// `steps` samples across the band segment of the sun ray, reading the
+/// detail noise as the clouds' own shadow rays do (without it the field
+/// near the base is wider than the cloud, and the shadows were large dark
+/// patches), at [`GROUND_SHADOW_FOOTPRINT_M`].
+pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
+    let Some((t0, t1)) = band_segment(p, sun_dir, d.band_bottom_m, d.band_top_m, 20_000.0) else {
+        return 1.0;
+    };
+    let dt = (t1 - t0) / steps.max(1) as f32;
+    let tau: f32 = (0..steps.max(1))
+        .map(|i| {
+            let q = p + sun_dir * (t0 + (i as f32 + 0.5) * dt);
+            density_at(q, f, d, true, GROUND_SHADOW_FOOTPRINT_M) * dt
+        })
+        .sum();
+    (-tau).exp()
 }
 
 #[cfg(test)]

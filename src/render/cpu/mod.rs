@@ -14,6 +14,7 @@ pub mod exposure;
 pub mod frame;
 pub mod glare;
 pub mod land;
+pub mod light_grid;
 pub mod light_transport;
 pub mod light_volume;
 pub mod lighting;

@@ -7,18 +7,18 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
-use super::density::{DensityParams, Fields, band_segment, density_at};
-use super::frame::{Frame, MIN_TRANSMITTANCE};
+use super::density::{band_segment, density_at};
+use super::frame::{Frame, MIN_TRANSMITTANCE, diffused_light};
 use super::land::{flat_ground_albedo, terrain_albedo};
 use super::lighting::{
-    ALBEDO, LightGains, ShadowSteps, forward_step_factor, integrate_step, light_gains,
-    shadow_offset, sun_optical_depth, sun_scattering,
+    ALBEDO, ShadowSteps, ambient_light, cloud_shadow, forward_step_factor, integrate_step,
+    light_gains, shadow_offset, sun_optical_depth, sun_scattering,
 };
 use super::sea::sea_reflection_change;
+use super::sea::sea_waves_at;
 use super::sky::{
     aerial, background_radiance, ground_up, sky_ambient, sun_direction, sun_light_at,
 };
-use super::waves::sea_waves_at;
 use crate::render::sampling;
 use crate::render::terrain::Heightfield;
 
@@ -87,17 +87,6 @@ pub fn march_step_count(steps: u32, log_ratio: f32) -> u32 {
 
 /// Sub-samples of a coarse march interval that touches cloud.
 pub const REFINE: u32 = 4;
-
-/// The sky's and the ground's light scattered at height fraction `eta` of
-/// the band (0 bottom, 1 top), from the upper sky's `sky_up / 4`, weighted
-/// from 0.35 at the bottom to 1 at the top, times the `gains`' `ambient`
-/// ([`super::lighting::AMBIENT_GAIN`] beside the light volume), and the ground's `ground /
-/// 4`, weighted from 1 at the bottom to 0 at the top, times their
-/// `ground` ([`super::lighting::GROUND_LIGHT_GAIN`]).
-#[inline]
-pub fn ambient_light(sky_top: Vec3, ground: Vec3, eta: f32, gains: &LightGains) -> Vec3 {
-    sky_top * ((0.35 + 0.65 * eta) * gains.ambient) + ground * ((1.0 - eta) * gains.ground)
-}
 
 /// Marches one ray (the per-pixel function; `march_ray` in WGSL); `dither`
 /// in `[0, 1)` places the samples within their steps (0.5: centres) and,
@@ -231,21 +220,6 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     }
 }
 
-/// The light volume's transported sunlight at `p` scattered toward the
-/// eye (`to_eye`, against the ray), per unit scattering coefficient and
-/// sun irradiance ([`super::light_volume::LightVolume::light_toward`] times the transport's
-/// gain, [`super::lighting::FLUENCE_GAIN`]): 0 without one or without multiple scattering
-/// (`octaves` 0).
-#[inline]
-pub fn diffused_light(p: Vec3, to_eye: Vec3, octaves: u32, fr: &Frame) -> f32 {
-    match fr.light {
-        Some(v) if octaves > 0 => {
-            LightGains::TRANSPORT.fluence * v.light_toward(p, to_eye, fr.density.map_extent_m)
-        }
-        _ => 0.0,
-    }
-}
-
 /// Radiance of the terrain at `p` (distance `t` along `dir`, seen by a
 /// pixel of cone angle `spread`): lit by the sun through the clouds
 /// (their shadow, when shadows are on), the sky and the sunlight the
@@ -299,32 +273,6 @@ pub fn flat_ground_shadow(origin: Vec3, dir: Vec3, sun_dir: Vec3, fr: &Frame) ->
 /// (`GROUND_SHADOW_STEPS` in WGSL): one ray across the band per ground
 /// pixel, whatever `shadow_steps` the clouds' own light takes.
 pub const GROUND_SHADOW_STEPS: u32 = 12;
-
-/// The footprint the ground's cloud shadows read the density at, m
-/// (`GROUND_SHADOW_FOOTPRINT_M` in WGSL): twice
-/// [`super::density::FINE_SHARP_M`], so they read no fine billows (12
-/// samples across the band would only alias them), and at the default
-/// detail scale the finest mip level of everything else.
-pub const GROUND_SHADOW_FOOTPRINT_M: f32 = 2.0 * super::density::FINE_SHARP_M;
-
-/// Transmittance of the cloud band from a ground point `p` toward the sun:
-/// `steps` samples across the band segment of the sun ray, reading the
-/// detail noise as the clouds' own shadow rays do (without it the field
-/// near the base is wider than the cloud, and the shadows were large dark
-/// patches), at [`GROUND_SHADOW_FOOTPRINT_M`].
-pub fn cloud_shadow(p: Vec3, sun_dir: Vec3, steps: u32, f: &Fields, d: &DensityParams) -> f32 {
-    let Some((t0, t1)) = band_segment(p, sun_dir, d.band_bottom_m, d.band_top_m, 20_000.0) else {
-        return 1.0;
-    };
-    let dt = (t1 - t0) / steps.max(1) as f32;
-    let tau: f32 = (0..steps.max(1))
-        .map(|i| {
-            let q = p + sun_dir * (t0 + (i as f32 + 0.5) * dt);
-            density_at(q, f, d, true, GROUND_SHADOW_FOOTPRINT_M) * dt
-        })
-        .sum();
-    (-tau).exp()
-}
 
 #[cfg(test)]
 #[path = "renderer_tests.rs"]

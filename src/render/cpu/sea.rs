@@ -6,22 +6,19 @@
 //! layer). Twins of the WGSL functions of the same names in
 //! `shaders/sea.wgsl`.
 
-use std::f32::consts::PI;
-
 use glam::Vec3;
 
 use super::density::{band_segment, density_at};
+use super::frame::diffused_light;
 use super::frame::{Frame, MIN_TRANSMITTANCE};
 use super::lighting::ALBEDO;
+use super::lighting::{ambient_light, cloud_shadow};
 use super::lighting::{integrate_step, light_gains, sun_scattering};
-#[cfg(doc)]
-use super::renderer::march_ray;
-use super::renderer::{ambient_light, cloud_shadow, diffused_light};
 use super::sky::{
     ground_haze_transmittance, ground_up, mirrored_sky, sea_fresnel, sea_mirror, sky_ambient,
     sun_light_at,
 };
-use super::waves::{flat_sea, sea_waves_at};
+use super::waves::{cross_slope, flat_sea, reflected_elevation, reflected_ray, sea_waves};
 use crate::render::sampling::GOLDEN;
 
 /// Reflected rays a sea pixel averages (`REFLECTION_RAYS` in WGSL), one
@@ -58,68 +55,6 @@ pub fn reflection_step_count(length: f32) -> u32 {
 
 /// Samples of each of its steps' shadow rays (`REFLECTION_SHADOW_STEPS`).
 pub const REFLECTION_SHADOW_STEPS: u32 = 2;
-/// The lowest elevation (radians, about 0.6°) a wave sends a reflected
-/// ray to; the facets that would send it lower are hidden behind the
-/// next wave at the grazing angles where that happens.
-pub const REFLECTION_MIN_ELEVATION: f32 = 0.01;
-
-/// The elevation (radians) of a ray the wind-roughened sea reflects,
-/// where the mirror ray of the waves the pixel resolves rises at `mirror`
-/// radians, at the quantile `u` in `(0, 1)` of the slopes it does not,
-/// of mean square `variance` (both directions together;
-/// [`super::waves::sea_waves`]).
-///
-/// A facet tilted by a slope `s` toward or away from the viewer turns
-/// the reflected ray up or down by `2 s` (sideways tilts turn it in
-/// azimuth: [`cross_slope`], [`reflected_ray`]). The mean square slope
-/// (far away all of Cox and Munk's 1954 `0.003 + 0.00512 U` for a wind
-/// of `U` m/s) is split between the two directions, so the
-/// elevation spreads with a standard deviation of `√(2 · variance)`: 0.28
-/// rad (16°) far out at 7 m/s, 0.08 rad on a calm sea. The spread is a logistic
-/// distribution of that deviation (its quantile in closed form; its
-/// cumulative distribution within 0.02 of a Gaussian's), cut off below
-/// [`REFLECTION_MIN_ELEVATION`]: the waves draw a mirrored cloud out
-/// into a vertical smear, near the horizon only upward.
-#[inline]
-pub fn reflected_elevation(mirror: f32, variance: f32, u: f32) -> f32 {
-    let deviation = (2.0 * variance.max(0.0)).sqrt();
-    // A logistic of scale s has the deviation s·π/√3.
-    let s = deviation * 3f32.sqrt() / PI;
-    let lowest = 1.0 / (1.0 + ((mirror - REFLECTION_MIN_ELEVATION) / s).exp());
-    let q = (lowest + (1.0 - lowest) * u).clamp(1e-6, 1.0 - 1e-6);
-    mirror + s * (q / (1.0 - q)).ln()
-}
-
-/// A wave's slope across the line of sight at the quantile `u` in `(0,
-/// 1)`, of the slopes of mean square `variance` a pixel does not resolve:
-/// a logistic of their deviation in one direction, `√(variance / 2)`
-/// (far out 0.14 at 7 m/s), as [`reflected_elevation`]'s slopes along it.
-#[inline]
-pub fn cross_slope(variance: f32, u: f32) -> f32 {
-    let deviation = (0.5 * variance.max(0.0)).sqrt();
-    let s = deviation * 3f32.sqrt() / PI;
-    let q = u.clamp(1e-6, 1.0 - 1e-6);
-    s * (q / (1.0 - q)).ln()
-}
-
-/// The ray a wave sends up from the sea, about a mirror ray that rises at
-/// `mirror` radians, horizontally along `across` (unit; the resolved
-/// waves' mirror ray, [`super::sky::sea_mirror`]): rising at
-/// elevation `e` ([`reflected_elevation`]) and turned sideways by the
-/// wave's slope `slope` across the line of sight ([`cross_slope`]). A
-/// facet tilted sideways by `s` adds `s (sin(mirror) + sin(e))` of the
-/// ray's length sideways (to first order in `s`, whatever the facet's
-/// tilt toward the viewer that sends the ray to `e`): up to `2 s`
-/// looking straight down, and near the horizon still some degrees for
-/// the steep rays that reach the clouds (2.8° at `s` 0.14, a mirror ray
-/// 2° down and a reflected ray 17.6° up). A mirrored cloud's streak is
-/// as wide as the cloud, its sides softened.
-#[inline]
-pub fn reflected_ray(across: Vec3, mirror: f32, e: f32, slope: f32) -> Vec3 {
-    let side = Vec3::new(-across.z, 0.0, across.x);
-    let sideways = slope * (mirror.sin() + e.sin());
-    (across * e.cos() + side * sideways + Vec3::Y * e.sin()).normalize()
-}
 
 /// The clouds mirrored by the sea where a ray that meets no terrain
 /// reaches it (y = 0; the flat mean surface, as the sky's reflection):
@@ -262,7 +197,7 @@ pub fn sea_reflection_change(
 /// each lit sample by the sun through [`cloud_shadow`] with
 /// [`REFLECTION_SHADOW_STEPS`] samples (the octaves as in the clouds' own
 /// light) and by the sky's and the ground's ambient (`light_in`): a coarser
-/// twin of [`march_ray`], for a reflection the Fresnel factor dims to a
+/// twin of `renderer::march_ray`, for a reflection the Fresnel factor dims to a
 /// few percent looking down. The clouds are read at the level of detail
 /// of twice the Cox-Munk slopes' deviation times the distance
 /// (`light_in.blur`), so that a few samples across the band do not
@@ -317,4 +252,30 @@ pub fn reflected_clouds(
         }
     }
     (light, transmittance)
+}
+
+/// The waves ([`sea_waves`]) where a ray of cone angle `spread` from
+/// `origin` along `dir` meets the sea (y = 0) in `fr`; [`flat_sea`] where
+/// it looks up, the camera is under the sea or the sea lies beyond
+/// `max_distance_m`; `None` over land.
+pub fn sea_waves_at(origin: Vec3, dir: Vec3, spread: f32, fr: &Frame) -> Option<Vec3> {
+    let q = &fr.quality;
+    let wind = q.sea_wind_mps?;
+    if dir.y >= 0.0 || origin.y <= 0.0 {
+        return Some(flat_sea(wind));
+    }
+    let t = origin.y / -dir.y;
+    if t > q.max_distance_m {
+        return Some(flat_sea(wind));
+    }
+    Some(sea_waves(
+        origin.x + dir.x * t,
+        origin.z + dir.z * t,
+        dir,
+        spread,
+        t,
+        wind,
+        q.sea_wind_toward_deg,
+        q.sea_time_s,
+    ))
 }

@@ -21,11 +21,11 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::lighting::phase_hg;
-use super::sea::{reflected_elevation, reflected_ray};
 use super::sky_luts::{
     SkyLuts, SkyParams, aerial_perspective, sky_view_radiance, sun_disk_radiance, sun_radiance_at,
 };
 use super::waves::wave_normal;
+use super::waves::{reflected_elevation, reflected_ray};
 
 /// Relative sun irradiance: sunlight is about five times the sky's
 /// illuminance on a clear day, so a sunlit cloud is brighter than the sky.
@@ -463,7 +463,7 @@ pub const SKY_MIRROR_RAYS: u32 = 8;
 /// the mean of the sky along [`SKY_MIRROR_RAYS`] rays about the resolved
 /// waves' mirror ray ([`sea_mirror`]), one at the middle of each stratum
 /// of the slopes the pixel does not resolve
-/// ([`super::sea::reflected_elevation`]; turned up or down, not
+/// ([`super::waves::reflected_elevation`]; turned up or down, not
 /// sideways, since the sky changes little in azimuth). A flat mirror
 /// would show the far sea as bright as the sky at the horizon, where its
 /// rough waves send the reflected rays on average 10-15° up, to a deeper

@@ -14,12 +14,11 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::frame::{Frame, MIN_TRANSMITTANCE};
-use super::lighting::ALBEDO;
-use super::lighting::{LightGains, integrate_step, sun_scattering};
-use super::renderer::ambient_light;
-use super::sky::{ground_up, sky_ambient, sun_direction, sun_light_at};
-use super::standalone::{analytic, hazed_clouds, render_standalone};
+use super::frame::Frame;
+use super::sky::sun_direction;
+use super::standalone::{
+    StandaloneMarch, analytic, hazed_clouds, render_standalone, standalone_light, standalone_step,
+};
 use super::tone_map::to_srgb8;
 
 /// How far the fBm moves a spheroid's surface (κ of their Eq. 2).
@@ -373,11 +372,8 @@ pub fn march_spheroids(
     let sun_dir = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
     let steps = q.steps.max(1);
     let dt = total / steps as f32;
-    let cos = dir.dot(sun_dir);
-    let sun = sun_light_at(sky, 0.5 * (d.band_bottom_m + d.band_top_m), sun_dir);
-    let sky_top = sky_ambient(sky, sun_dir) * 0.25;
-    let ground = ground_up(sky, sun_dir, q.sea_wind_mps.is_some()) * 0.25;
-    let (mut transmittance, mut light, mut depth_weighted) = (1.0f32, Vec3::ZERO, 0.0f32);
+    let l = standalone_light(sky, dir, sun_dir, fr);
+    let mut march = StandaloneMarch::START;
     let (mut seg, mut before) = (0usize, 0.0f32);
     for i in 0..steps {
         let s = (i as f32 + dither) * dt;
@@ -397,21 +393,11 @@ pub fn march_spheroids(
             continue;
         }
         let tau_sun = light_grid_depth(p, grid);
-        let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
-        // No light volume here: the gains of the renderers without one.
-        let g = &LightGains::ALONE;
-        let ambient = ambient_light(sky_top, ground, eta, g);
-        let src = (sun * sun_scattering(tau_sun, cos, sun_dir.y, sigma_t, q.octaves, g) + ambient)
-            * (sigma_t * ALBEDO);
-        let step_t = (-sigma_t * dt).exp();
-        light += integrate_step(src, sigma_t, dt) * transmittance;
-        depth_weighted += t * transmittance * (1.0 - step_t);
-        transmittance *= step_t;
-        if transmittance < MIN_TRANSMITTANCE {
+        if standalone_step(&mut march, &l, p, t, dt, sigma_t, tau_sun, fr) {
             break;
         }
     }
-    hazed_clouds(sky, light, transmittance, depth_weighted, dir, sun_dir)
+    hazed_clouds(sky, &march, dir, sun_dir)
 }
 
 /// A `width x height` image of linear radiance (row-major), the twin of

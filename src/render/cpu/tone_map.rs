@@ -134,6 +134,12 @@ pub fn dither_encoded(e: f32, noise: f32) -> f32 {
     e + noise * room / 255.0
 }
 
+/// Rec. 709 luminance of a linear sRGB colour.
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

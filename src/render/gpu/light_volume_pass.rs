@@ -1,6 +1,6 @@
 //! The light volume on the GPU: the twin of
 //! [`crate::render::cpu::light_volume`] and
-//! [`crate::render::cpu::light_transport`] (`shaders/light_volume.wgsl`,
+//! [`crate::render::cpu::light_transport`] (`shaders/light_grid.wgsl`,
 //! `shaders/light_transport.wgsl`, `shaders/light_volume_build.wgsl`).
 //! Built by compute passes of its own, submitted before the frame's,
 //! whenever P, the sun or the density changed
@@ -19,12 +19,12 @@ use super::bind::{self, compute_entry};
 use super::context::{GpuContext, GpuError};
 use super::shaders;
 use crate::render::cpu::density::DensityParams;
-use crate::render::cpu::light_volume::{LightVolumeGrid, light_photons};
+use crate::render::cpu::light_grid::{LightVolumeGrid, light_photons};
 
 /// The build's name (its compute pass's label).
 pub const PASS_LIGHT_VOLUME: &str = "light_volume";
 
-// Keep in sync with shaders/light_volume.wgsl: LightVolumeGrid.
+// Keep in sync with shaders/light_grid.wgsl: LightVolumeGrid.
 /// The grid as WGSL reads it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

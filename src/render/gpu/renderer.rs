@@ -52,7 +52,7 @@ use super::uniforms::{FrameInputs, FrameUniforms};
 use super::{bind, bind::Recorder};
 use crate::render::camera::{ToView, View};
 use crate::render::cloud_map::CloudMap;
-use crate::render::cpu::light_volume::LightVolumeGrid;
+use crate::render::cpu::light_grid::LightVolumeGrid;
 use crate::render::soft_field::{SPREAD_M, soft_field};
 use crate::render::terrain::Heightfield;
 use crate::sim::ProjectedField;

@@ -68,8 +68,8 @@ pub const VOLUME: &str = include_str!("../../../shaders/volume.wgsl");
 
 /// The light volume's grid (after [`CLOUDS`]; each module that appends it
 /// declares `volume_grid`).
-pub const LIGHT_VOLUME: &str = include_str!("../../../shaders/light_volume.wgsl");
-/// The sunlight's transport (after [`LIGHT_VOLUME`]; reads `light_cells`,
+pub const LIGHT_GRID: &str = include_str!("../../../shaders/light_grid.wgsl");
+/// The sunlight's transport (after [`LIGHT_GRID`]; reads `light_cells`,
 /// adds to `light_tracks`).
 pub const LIGHT_TRANSPORT: &str = include_str!("../../../shaders/light_transport.wgsl");
 /// The light volume's compute entry points (after [`LIGHT_TRANSPORT`]).
@@ -212,7 +212,7 @@ pub fn volume_pass() -> String {
 /// (the density) and group 1 (its buffers).
 pub fn light_volume_build() -> String {
     format!(
-        "{}{NO_LIGHT}\n{LIGHT_VOLUME}\n{LIGHT_TRANSPORT}\n{LIGHT_VOLUME_BUILD}",
+        "{}{NO_LIGHT}\n{LIGHT_GRID}\n{LIGHT_TRANSPORT}\n{LIGHT_VOLUME_BUILD}",
         sky_model(false)
     )
 }

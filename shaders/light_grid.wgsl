@@ -1,5 +1,5 @@
 // The light volume's grid: the twin of LightVolumeGrid in
-// src/render/cpu/light_volume.rs (same names). Appended after CLOUDS
+// src/render/cpu/light_grid.rs (same names). Appended after CLOUDS
 // by the light volume's build, before light_transport.wgsl and
 // light_volume_build.wgsl, which declares `volume_grid`. The cloud
 // pass reads the transported light from the three textures the build
