@@ -7,7 +7,7 @@
 //! from a [`LightGrid`] precomputed on the CPU (their illumination pass)
 //! instead of a shadow ray per sample. The light is the cloud map's own:
 //! the same phase functions and multiple-scattering octaves
-//! ([`sun_scattering`]), ambient and sky, under the analytic sky (its
+//! ([`super::lighting::sun_scattering`]), ambient and sky, under the analytic sky (its
 //! pipeline binds no sky tables).
 
 use bytemuck::{Pod, Zeroable};
