@@ -163,12 +163,28 @@ impl App {
         }
     }
 
+    /// One frame: the clock, the UI and what it asked for, then the
+    /// picture.
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        self.advance();
+        let Some(window) = self.window.clone() else {
+            return Ok(());
+        };
+        let Some((actions, out)) = self.run_ui(&window) else {
+            return Ok(());
+        };
+        self.apply(actions);
+        self.draw(event_loop, &window, out)
+    }
+
+    /// Steps the clocks, the world and the camera by one frame: the wall
+    /// time since the last (at most 0.25 s), or a fixed 1/30 s while
+    /// taking a screenshot.
+    fn advance(&mut self) {
         let now = Instant::now();
         let wall_dt = (now - self.last_frame).as_secs_f64();
         self.last_frame = now;
-        let screenshot = self.args.screenshot.is_some();
-        let dt = if screenshot {
+        let dt = if self.args.screenshot.is_some() {
             1.0 / 30.0
         } else {
             wall_dt.min(0.25)
@@ -179,12 +195,13 @@ impl App {
         self.camera.update(dt as f32);
         self.timings.physics_ms = self.world.physics_ms;
         self.timings.projection_ms = self.world.projection_ms;
-        let (Some(window), Some(state)) = (self.window.clone(), self.egui_state.as_mut()) else {
-            return Ok(());
-        };
+    }
 
-        // The UI.
-        let raw = state.take_egui_input(&window);
+    /// The panel, the debug views and the overlay; what the user asked
+    /// for, and what egui drew. `None` before egui is set up.
+    fn run_ui(&mut self, window: &Window) -> Option<(ui::Actions, egui::FullOutput)> {
+        let state = self.egui_state.as_mut()?;
+        let raw = state.take_egui_input(window);
         let mut actions = ui::Actions::default();
         let description = self
             .gfx
@@ -200,7 +217,7 @@ impl App {
             &self.timings,
         );
         let show_panel = !self.args.hide_panel;
-        let out = self.egui_ctx.run_ui(raw, |ui| {
+        let mut out = self.egui_ctx.run_ui(raw, |ui| {
             if show_panel {
                 egui::Panel::left("controls")
                     .default_size(300.0)
@@ -215,7 +232,13 @@ impl App {
             ui::debug_views(ui.ctx(), world, views);
             ui::overlay(ui.ctx(), timings, &description);
         });
-        state.handle_platform_output(&window, out.platform_output);
+        state.handle_platform_output(window, std::mem::take(&mut out.platform_output));
+        Some((actions, out))
+    }
+
+    /// Carries out what the panel asked for (load, save, one step) and
+    /// hands the renderer what changed: its settings, the terrain, P.
+    fn apply(&mut self, actions: ui::Actions) {
         if let Some(p) = actions.load {
             self.load_scene(&p);
         }
@@ -229,7 +252,7 @@ impl App {
             self.world.advance(self.world.scene.physics.dt_s);
         }
         let Some(g) = &mut self.gfx else {
-            return Ok(());
+            return;
         };
         if actions.panel_changed {
             let changes = self.world.apply_panel();
@@ -244,7 +267,20 @@ impl App {
             g.clouds.update_field(&g.ctx.queue, &self.world.field);
             self.uploaded = Some(self.world.field_version);
         }
+    }
 
+    /// Draws the clouds and the UI into the window's surface and presents
+    /// it; on a screenshot's last frame, saves it and ends the loop.
+    fn draw(
+        &mut self,
+        event_loop: &ActiveEventLoop,
+        window: &Window,
+        out: egui::FullOutput,
+    ) -> Result<()> {
+        let screenshot = self.args.screenshot.is_some();
+        let Some(g) = &mut self.gfx else {
+            return Ok(());
+        };
         // Nothing to draw into while minimised.
         let (width, height) = g.clouds.size();
         if width == 0 || height == 0 {
@@ -289,46 +325,7 @@ impl App {
                 }
             }
         }
-
-        // egui on top.
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [g.config.width, g.config.height],
-            pixels_per_point: window.scale_factor() as f32,
-        };
-        let jobs = self
-            .egui_ctx
-            .tessellate(out.shapes, screen.pixels_per_point);
-        for (id, deltas) in &out.textures_delta.set {
-            for delta in deltas {
-                g.egui
-                    .update_texture(&g.ctx.device, &g.ctx.queue, *id, delta);
-            }
-        }
-        let extra =
-            g.egui
-                .update_buffers(&g.ctx.device, &g.ctx.queue, &mut encoder, &jobs, &screen);
-        {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            g.egui.render(&mut pass.forget_lifetime(), &jobs, &screen);
-        }
-        for id in &out.textures_delta.free {
-            g.egui.free_texture(id);
-        }
+        let extra = draw_egui(g, &self.egui_ctx, &mut encoder, &view, window, out);
         let last = screenshot && self.frames_done + 1 >= self.args.frames;
         g.ctx
             .queue
@@ -368,6 +365,56 @@ impl App {
         }
         Ok(())
     }
+}
+
+/// Records egui's `out` over the picture in `view`: its textures, its
+/// buffers (the command buffers egui needs submitted first, returned) and
+/// its render pass.
+fn draw_egui(
+    g: &mut Gfx,
+    egui_ctx: &egui::Context,
+    encoder: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    window: &Window,
+    out: egui::FullOutput,
+) -> Vec<wgpu::CommandBuffer> {
+    let screen = egui_wgpu::ScreenDescriptor {
+        size_in_pixels: [g.config.width, g.config.height],
+        pixels_per_point: window.scale_factor() as f32,
+    };
+    let jobs = egui_ctx.tessellate(out.shapes, screen.pixels_per_point);
+    for (id, deltas) in &out.textures_delta.set {
+        for delta in deltas {
+            g.egui
+                .update_texture(&g.ctx.device, &g.ctx.queue, *id, delta);
+        }
+    }
+    let extra = g
+        .egui
+        .update_buffers(&g.ctx.device, &g.ctx.queue, encoder, &jobs, &screen);
+    {
+        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("egui"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        g.egui.render(&mut pass.forget_lifetime(), &jobs, &screen);
+    }
+    for id in &out.textures_delta.free {
+        g.egui.free_texture(id);
+    }
+    extra
 }
 
 impl ApplicationHandler for App {

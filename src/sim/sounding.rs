@@ -72,9 +72,252 @@ pub struct Sounding {
     source: PathBuf,
 }
 
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Humidity {
     DewpointC,
     RelativeHumidityPct,
+}
+
+impl Humidity {
+    /// The column's name.
+    fn column(self) -> &'static str {
+        match self {
+            Humidity::DewpointC => "dewpoint_C",
+            Humidity::RelativeHumidityPct => "relative_humidity_pct",
+        }
+    }
+}
+
+/// Makes the error of a line of the file being read.
+type LineError<'a> = dyn Fn(u64, String) -> SoundingError + 'a;
+
+/// Where a CSV sounding's columns are.
+struct Columns {
+    height: usize,
+    pressure: usize,
+    temperature: usize,
+    humidity_column: usize,
+    humidity: Humidity,
+    header_line: u64,
+}
+
+impl Columns {
+    /// Reads the header: height, pressure and temperature, and a dewpoint
+    /// or else a relative humidity column.
+    fn read(reader: &mut csv::Reader<&[u8]>, err: &LineError) -> Result<Self, SoundingError> {
+        let headers = reader
+            .headers()
+            .map_err(|e| err(1, format!("cannot read header: {e}")))?
+            .clone();
+        let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
+        let header_line = reader.position().line().max(1);
+        let missing = |name: &str| {
+            err(
+                header_line,
+                format!(
+                    "missing column `{name}`; expected header \
+                     `height_m,pressure_hPa,temperature_C,dewpoint_C` \
+                     (or relative_humidity_pct instead of dewpoint_C)"
+                ),
+            )
+        };
+        let need = |name: &str| col(name).ok_or_else(|| missing(name));
+        let height = need("height_m")?;
+        let pressure = need("pressure_hPa")?;
+        let temperature = need("temperature_C")?;
+        let (humidity_column, humidity) = match (col("dewpoint_C"), col("relative_humidity_pct")) {
+            (Some(c), _) => (c, Humidity::DewpointC),
+            (None, Some(c)) => (c, Humidity::RelativeHumidityPct),
+            (None, None) => return Err(missing("dewpoint_C")),
+        };
+        Ok(Self {
+            height,
+            pressure,
+            temperature,
+            humidity_column,
+            humidity,
+            header_line,
+        })
+    }
+
+    /// One data row, its values in range.
+    fn row(&self, record: &csv::StringRecord, err: &LineError) -> Result<Row, SoundingError> {
+        let line = record.position().map_or(0, |p| p.line());
+        let field = |c: usize, name: &str| -> Result<Option<f64>, SoundingError> {
+            let s = record.get(c).unwrap_or("");
+            if s.is_empty() {
+                return Ok(None);
+            }
+            let v: f64 = s
+                .parse()
+                .map_err(|_| err(line, format!("`{name}` is `{s}`, expected a number")))?;
+            if !v.is_finite() {
+                return Err(err(
+                    line,
+                    format!("`{name}` is `{s}`, expected a finite number"),
+                ));
+            }
+            Ok(Some(v))
+        };
+        let required = |c: usize, name: &str| -> Result<f64, SoundingError> {
+            field(c, name)?.ok_or_else(|| err(line, format!("`{name}` is empty")))
+        };
+        let h = required(self.height, "height_m")?;
+        let p = field(self.pressure, "pressure_hPa")?;
+        let t = required(self.temperature, "temperature_C")?;
+        let hum = required(self.humidity_column, self.humidity.column())?;
+        if h < 0.0 {
+            return Err(err(
+                line,
+                format!("`height_m` is {h}, expected >= 0 (height above ground)"),
+            ));
+        }
+        if let Some(p) = p
+            && !(1.0..=1200.0).contains(&p)
+        {
+            return Err(err(
+                line,
+                format!("`pressure_hPa` is {p}, expected 1..=1200"),
+            ));
+        }
+        if !(-120.0..=70.0).contains(&t) {
+            return Err(err(
+                line,
+                format!("`temperature_C` is {t}, expected -120..=70"),
+            ));
+        }
+        match self.humidity {
+            Humidity::DewpointC
+                if hum < -150.0
+                    || (hum > t + DEWPOINT_EXCESS_MAX_K && dewpoint_humidity(hum, t) > RH_MAX) =>
+            {
+                return Err(err(
+                    line,
+                    format!(
+                        "`dewpoint_C` is {hum}, expected -150 or more, and at most \
+                         {DEWPOINT_EXCESS_MAX_K} K above `temperature_C` {t} or \
+                         {:.0} % relative humidity (it gives {:.0} %)",
+                        RH_MAX * 100.0,
+                        dewpoint_humidity(hum, t) * 100.0
+                    ),
+                ));
+            }
+            Humidity::RelativeHumidityPct if !(0.0..=RH_MAX * 100.0).contains(&hum) => {
+                return Err(err(
+                    line,
+                    format!(
+                        "`relative_humidity_pct` is {hum}, expected 0..={:.0}",
+                        RH_MAX * 100.0
+                    ),
+                ));
+            }
+            _ => {}
+        }
+        Ok(Row { line, h, p, t, hum })
+    }
+}
+
+/// One row of a CSV sounding as written: height (m), pressure (hPa, if
+/// given), temperature (°C), dewpoint (°C) or relative humidity (%).
+struct Row {
+    line: u64,
+    h: f64,
+    p: Option<f64>,
+    t: f64,
+    hum: f64,
+}
+
+impl Row {
+    /// The row lies above `prev`: higher, and at a lower pressure where
+    /// both give one.
+    fn check_above(&self, prev: &Row, err: &LineError) -> Result<(), SoundingError> {
+        let (h, line) = (self.h, self.line);
+        if h <= prev.h {
+            return Err(err(
+                line,
+                format!(
+                    "`height_m` is {h}, not above the previous row's {} (line {}): rows must be sorted by strictly increasing height",
+                    prev.h, prev.line
+                ),
+            ));
+        }
+        if let (Some(p), Some(pp)) = (self.p, prev.p)
+            && p >= pp
+        {
+            return Err(err(
+                line,
+                format!(
+                    "`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The levels of `rows` (at least 2) in SI units, each missing pressure
+/// filled by hydrostatic integration from the nearest level below with
+/// one (the lowest levels from the nearest above; from
+/// `surface_pressure_pa` at the ground when no row has one).
+fn levels(rows: &[Row], humidity: Humidity, surface_pressure_pa: f64) -> Vec<Level> {
+    let mut p_pa: Vec<Option<f64>> = rows.iter().map(|r| r.p.map(|p| p * 100.0)).collect();
+    let t_k: Vec<f64> = rows.iter().map(|r| r.t + ZERO_CELSIUS_K).collect();
+    if p_pa.iter().all(Option::is_none) {
+        p_pa[0] = Some(surface_pressure_pa);
+    }
+    let first = p_pa.iter().position(Option::is_some).unwrap_or(0);
+    // Mixing ratio needs pressure; virtual temperature needs mixing
+    // ratio; integrate level to level with 1 m sub-steps.
+    let mixing = |i: usize, p: f64| -> f64 {
+        match humidity {
+            Humidity::DewpointC => mixing_ratio_from_dewpoint(rows[i].hum + ZERO_CELSIUS_K, p),
+            Humidity::RelativeHumidityPct => {
+                rows[i].hum / 100.0 * saturation_mixing_ratio(t_k[i], p)
+            }
+        }
+    };
+    let integrate = |from: usize, to: usize, p_from: f64| -> f64 {
+        let (a, b) = (from, to);
+        let dz_total = rows[b].h - rows[a].h;
+        let steps = (dz_total.abs().ceil() as usize).max(1);
+        let dz = dz_total / steps as f64;
+        let mut ln_p = p_from.ln();
+        let qa = mixing(a, p_from);
+        let qb_guess = mixing(b, p_from);
+        for s in 0..steps {
+            let f0 = s as f64 / steps as f64;
+            let f1 = (s + 1) as f64 / steps as f64;
+            let tv = |f: f64| {
+                let t = t_k[a] + f * (t_k[b] - t_k[a]);
+                let q = qa + f * (qb_guess - qa);
+                t * (1.0 + 0.608 * q)
+            };
+            ln_p -= G * dz * 0.5 * (1.0 / tv(f0) + 1.0 / tv(f1)) / R_D;
+        }
+        ln_p.exp()
+    };
+    for i in (0..first).rev() {
+        let p_above = p_pa[i + 1].unwrap_or(surface_pressure_pa);
+        p_pa[i] = Some(integrate(i + 1, i, p_above));
+    }
+    for i in first + 1..rows.len() {
+        if p_pa[i].is_none() {
+            let p_below = p_pa[i - 1].unwrap_or(surface_pressure_pa);
+            p_pa[i] = Some(integrate(i - 1, i, p_below));
+        }
+    }
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let p = p_pa[i].unwrap_or(surface_pressure_pa);
+            Level {
+                height_m: r.h,
+                pressure_pa: Some(p),
+                temperature_k: t_k[i],
+                mixing_ratio: mixing(i, p).max(0.0),
+            }
+        })
+        .collect()
 }
 
 impl Sounding {
@@ -109,7 +352,9 @@ impl Sounding {
         }
     }
 
-    /// Parses our CSV.
+    /// Parses our CSV: the header's columns ([`Columns::read`]), each row
+    /// read and checked against its ranges and the row before, then the
+    /// missing pressures filled ([`levels`]).
     fn parse_csv(text: &str, path: &Path, surface_pressure_pa: f64) -> Result<Self, SoundingError> {
         let err = |line: u64, message: String| SoundingError::Invalid {
             path: path.to_owned(),
@@ -120,216 +365,27 @@ impl Sounding {
             .trim(csv::Trim::All)
             .comment(Some(b'#'))
             .from_reader(text.as_bytes());
-        let headers = reader
-            .headers()
-            .map_err(|e| err(1, format!("cannot read header: {e}")))?
-            .clone();
-        let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
-        let header_line = reader.position().line().max(1);
-        let need = |name: &str| {
-            col(name).ok_or_else(|| {
-                err(
-                    header_line,
-                    format!(
-                        "missing column `{name}`; expected header \
-                         `height_m,pressure_hPa,temperature_C,dewpoint_C` \
-                         (or relative_humidity_pct instead of dewpoint_C)"
-                    ),
-                )
-            })
-        };
-        let c_h = need("height_m")?;
-        let c_p = need("pressure_hPa")?;
-        let c_t = need("temperature_C")?;
-        let (c_q, humidity) = match (col("dewpoint_C"), col("relative_humidity_pct")) {
-            (Some(c), _) => (c, Humidity::DewpointC),
-            (None, Some(c)) => (c, Humidity::RelativeHumidityPct),
-            (None, None) => return Err(need("dewpoint_C").unwrap_err()),
-        };
-
-        struct Row {
-            line: u64,
-            h: f64,
-            p: Option<f64>,
-            t: f64,
-            hum: f64,
-        }
+        let columns = Columns::read(&mut reader, &err)?;
         let mut rows: Vec<Row> = Vec::new();
         for record in reader.records() {
             let record = record.map_err(|e| {
                 let line = e.position().map_or(0, |p| p.line());
                 err(line, format!("malformed row: {e}"))
             })?;
-            let line = record.position().map_or(0, |p| p.line());
-            let field = |c: usize, name: &str| -> Result<Option<f64>, SoundingError> {
-                let s = record.get(c).unwrap_or("");
-                if s.is_empty() {
-                    return Ok(None);
-                }
-                let v: f64 = s
-                    .parse()
-                    .map_err(|_| err(line, format!("`{name}` is `{s}`, expected a number")))?;
-                if !v.is_finite() {
-                    return Err(err(
-                        line,
-                        format!("`{name}` is `{s}`, expected a finite number"),
-                    ));
-                }
-                Ok(Some(v))
-            };
-            let required = |c: usize, name: &str| -> Result<f64, SoundingError> {
-                field(c, name)?.ok_or_else(|| err(line, format!("`{name}` is empty")))
-            };
-            let h = required(c_h, "height_m")?;
-            let p = field(c_p, "pressure_hPa")?;
-            let t = required(c_t, "temperature_C")?;
-            let hum = required(
-                c_q,
-                match humidity {
-                    Humidity::DewpointC => "dewpoint_C",
-                    Humidity::RelativeHumidityPct => "relative_humidity_pct",
-                },
-            )?;
-            if h < 0.0 {
-                return Err(err(
-                    line,
-                    format!("`height_m` is {h}, expected >= 0 (height above ground)"),
-                ));
-            }
-            if let Some(p) = p
-                && !(1.0..=1200.0).contains(&p)
-            {
-                return Err(err(
-                    line,
-                    format!("`pressure_hPa` is {p}, expected 1..=1200"),
-                ));
-            }
-            if !(-120.0..=70.0).contains(&t) {
-                return Err(err(
-                    line,
-                    format!("`temperature_C` is {t}, expected -120..=70"),
-                ));
-            }
-            match humidity {
-                Humidity::DewpointC
-                    if hum < -150.0
-                        || (hum > t + DEWPOINT_EXCESS_MAX_K
-                            && dewpoint_humidity(hum, t) > RH_MAX) =>
-                {
-                    return Err(err(
-                        line,
-                        format!(
-                            "`dewpoint_C` is {hum}, expected -150 or more, and at most \
-                             {DEWPOINT_EXCESS_MAX_K} K above `temperature_C` {t} or \
-                             {:.0} % relative humidity (it gives {:.0} %)",
-                            RH_MAX * 100.0,
-                            dewpoint_humidity(hum, t) * 100.0
-                        ),
-                    ));
-                }
-                Humidity::RelativeHumidityPct if !(0.0..=RH_MAX * 100.0).contains(&hum) => {
-                    return Err(err(
-                        line,
-                        format!(
-                            "`relative_humidity_pct` is {hum}, expected 0..={:.0}",
-                            RH_MAX * 100.0
-                        ),
-                    ));
-                }
-                _ => {}
-            }
+            let row = columns.row(&record, &err)?;
             if let Some(prev) = rows.last() {
-                if h <= prev.h {
-                    return Err(err(
-                        line,
-                        format!(
-                            "`height_m` is {h}, not above the previous row's {} (line {}): rows must be sorted by strictly increasing height",
-                            prev.h, prev.line
-                        ),
-                    ));
-                }
-                if let (Some(p), Some(pp)) = (p, prev.p)
-                    && p >= pp
-                {
-                    return Err(err(
-                        line,
-                        format!(
-                            "`pressure_hPa` is {p}, not below the previous row's {pp}: pressure must fall with height"
-                        ),
-                    ));
-                }
+                row.check_above(prev, &err)?;
             }
-            rows.push(Row { line, h, p, t, hum });
+            rows.push(row);
         }
         if rows.len() < 2 {
             return Err(err(
-                header_line,
+                columns.header_line,
                 format!("{} data rows, expected at least 2 levels", rows.len()),
             ));
         }
-
-        // Pressures: hydrostatic fill of the missing ones.
-        let mut p_pa: Vec<Option<f64>> = rows.iter().map(|r| r.p.map(|p| p * 100.0)).collect();
-        let t_k: Vec<f64> = rows.iter().map(|r| r.t + ZERO_CELSIUS_K).collect();
-        if p_pa.iter().all(Option::is_none) {
-            p_pa[0] = Some(surface_pressure_pa);
-        }
-        let first = p_pa.iter().position(Option::is_some).unwrap_or(0);
-        // Mixing ratio needs pressure; virtual temperature needs mixing
-        // ratio; integrate level to level with 1 m sub-steps.
-        let mixing = |i: usize, p: f64| -> f64 {
-            match humidity {
-                Humidity::DewpointC => mixing_ratio_from_dewpoint(rows[i].hum + ZERO_CELSIUS_K, p),
-                Humidity::RelativeHumidityPct => {
-                    rows[i].hum / 100.0 * saturation_mixing_ratio(t_k[i], p)
-                }
-            }
-        };
-        let integrate = |from: usize, to: usize, p_from: f64| -> f64 {
-            let (a, b) = (from, to);
-            let dz_total = rows[b].h - rows[a].h;
-            let steps = (dz_total.abs().ceil() as usize).max(1);
-            let dz = dz_total / steps as f64;
-            let mut ln_p = p_from.ln();
-            let qa = mixing(a, p_from);
-            let qb_guess = mixing(b, p_from);
-            for s in 0..steps {
-                let f0 = s as f64 / steps as f64;
-                let f1 = (s + 1) as f64 / steps as f64;
-                let tv = |f: f64| {
-                    let t = t_k[a] + f * (t_k[b] - t_k[a]);
-                    let q = qa + f * (qb_guess - qa);
-                    t * (1.0 + 0.608 * q)
-                };
-                ln_p -= G * dz * 0.5 * (1.0 / tv(f0) + 1.0 / tv(f1)) / R_D;
-            }
-            ln_p.exp()
-        };
-        for i in (0..first).rev() {
-            let p_above = p_pa[i + 1].unwrap_or(surface_pressure_pa);
-            p_pa[i] = Some(integrate(i + 1, i, p_above));
-        }
-        for i in first + 1..rows.len() {
-            if p_pa[i].is_none() {
-                let p_below = p_pa[i - 1].unwrap_or(surface_pressure_pa);
-                p_pa[i] = Some(integrate(i - 1, i, p_below));
-            }
-        }
-        let levels = rows
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                let p = p_pa[i].unwrap_or(surface_pressure_pa);
-                Level {
-                    height_m: r.h,
-                    pressure_pa: Some(p),
-                    temperature_k: t_k[i],
-                    mixing_ratio: mixing(i, p).max(0.0),
-                }
-            })
-            .collect();
         Ok(Self {
-            levels,
+            levels: levels(&rows, columns.humidity, surface_pressure_pa),
             source: path.to_owned(),
         })
     }

@@ -7,9 +7,10 @@ use anyhow::{Context, Result, bail};
 
 use cumulus::io::write_png_atomically;
 use cumulus::prepare::Prepared;
+use cumulus::render::cpu::frame::{Frame, Quality};
 use cumulus::render::gpu::GpuContext;
 use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
-use cumulus::scene::{Method, RenderMethod, Scene};
+use cumulus::scene::{Method, RenderMethod, RenderSettings, Scene};
 
 use crate::{
     check_output_file, gpu_context, guard_output_file, load_scene, progress_bar, with_overrides,
@@ -109,10 +110,58 @@ pub enum Backend {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    use cumulus::render::cpu::frame::Quality;
-    use cumulus::render::cpu::stills::{add_sun_glare, render_still};
-    use cumulus::report::render_quality;
+    let scene = scene_with_flags(&a)?;
+    for w in cumulus::prepare::view_warnings(&scene)? {
+        eprintln!("warning: {}: {w}", a.scene.display());
+    }
+    let r = &scene.render;
+    let factor = r.exposure_factor();
+    if factor != 1.0 && picture_is_png(a.out.as_deref()) {
+        eprintln!(
+            "auto_exposure: the sun {}° high, exposure {} x {:.4} ({:.1} stops)",
+            r.sun_elevation_deg,
+            r.exposure,
+            factor,
+            factor.log2()
+        );
+    }
+    let mut picture = None;
+    if let Some(out) = &a.out {
+        check_output_file(out)?;
+        picture = Some(Picture::of(out)?);
+        guard_output_file(out);
+    }
+    let gpu = choose_backend(a.backend)?;
+    check_backend_flags(&a, &scene, gpu.is_some())?;
+    if scene.simulation.method == Method::Endless {
+        return render_endless(gpu.as_ref(), &a, &scene, picture);
+    }
+    let bar = progress_bar(Prepared::frames(&scene), "simulating");
+    let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
+    bar.finish_and_clear();
+    let quality = Quality {
+        single_scattering: a.single_scattering,
+        ..r.quality()
+    };
+    if let Some(dir) = &a.quality_report {
+        // The CPU's frame, its light volume built once here (the GPU
+        // builds its own: a GPU picture does not wait for the CPU's).
+        quality_report(&prepared.frame(r, quality), r, dir)?;
+    }
+    if r.renderer == RenderMethod::Spheroids {
+        return render_spheroids(gpu.as_ref(), &a, &scene, &prepared, picture);
+    }
+    if let Some(ctx) = &gpu {
+        return render_gpu(ctx, &a, &scene, &prepared, picture);
+    }
+    match &a.out {
+        Some(out) => render_cpu(&a, &scene, &prepared, quality, out, picture),
+        None => Ok(()),
+    }
+}
 
+/// The scene of `--scene` with the flags that override its keys.
+fn scene_with_flags(a: &RenderArgs) -> Result<Scene> {
     let flags = [
         ("--width", "render.width"),
         ("--height", "render.height"),
@@ -120,7 +169,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ("--steps", "render.steps"),
         ("--light-photons", "render.light_photons"),
     ];
-    let scene = with_overrides(load_scene(&a.scene)?, &flags, |s| {
+    with_overrides(load_scene(&a.scene)?, &flags, |s| {
         let r = &mut s.render;
         if let Some(w) = a.width {
             r.width = w;
@@ -137,28 +186,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         if let Some(n) = a.light_photons {
             r.light_photons = n;
         }
-    })?;
-    for w in cumulus::prepare::view_warnings(&scene)? {
-        eprintln!("warning: {}: {w}", a.scene.display());
-    }
-    let mut picture = None;
-    let r = &scene.render;
-    let factor = r.exposure_factor();
-    if factor != 1.0 && picture_is_png(a.out.as_deref()) {
-        eprintln!(
-            "auto_exposure: the sun {}° high, exposure {} x {:.4} ({:.1} stops)",
-            r.sun_elevation_deg,
-            r.exposure,
-            factor,
-            factor.log2()
-        );
-    }
-    if let Some(out) = &a.out {
-        check_output_file(out)?;
-        picture = Some(Picture::of(out)?);
-        guard_output_file(out);
-    }
-    let gpu = match a.backend {
+    })
+}
+
+/// The GPU to render on (`None`: the CPU reference), saying which.
+fn choose_backend(backend: Backend) -> Result<Option<GpuContext>> {
+    Ok(match backend {
         Backend::Cpu => {
             eprintln!("backend: cpu (the CPU reference renderer)");
             None
@@ -178,11 +211,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
                 None
             }
         },
-    };
-    if gpu.is_none() && a.time_frames.is_some() {
+    })
+}
+
+/// The flags that only one backend or renderer reads: refused where they
+/// cannot be honoured, warned about where another machine would use them.
+fn check_backend_flags(a: &RenderArgs, scene: &Scene, gpu: bool) -> Result<()> {
+    if !gpu && a.time_frames.is_some() {
         bail!("--time-frames needs the GPU backend (--backend gpu)");
     }
-    if gpu.is_none() && a.frames.is_some() {
+    if !gpu && a.frames.is_some() {
         // Not an error: with --backend auto the same command runs on a
         // machine with a GPU, where --frames counts.
         eprintln!(
@@ -191,7 +229,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         );
     }
     if a.single_scattering
-        && (gpu.is_some()
+        && (gpu
             || scene.simulation.method == Method::Endless
             || scene.render.renderer == RenderMethod::Spheroids)
     {
@@ -200,78 +238,77 @@ pub fn run(a: RenderArgs) -> Result<()> {
              use --backend cpu with render.renderer = \"cloud_map\" and a simulated (not endless) scene"
         );
     }
-    if scene.simulation.method == Method::Endless {
-        return render_endless(gpu.as_ref(), &a, &scene, picture);
-    }
-    let bar = progress_bar(Prepared::frames(&scene), "simulating");
-    let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
+    Ok(())
+}
+
+/// `--quality-report DIR`: the error against cost of the step counts
+/// (render_quality.csv and .png) and the dither's high-pass energy,
+/// written to `dir` and printed.
+fn quality_report(frame: &Frame, r: &RenderSettings, dir: &Path) -> Result<()> {
+    use cumulus::report::render_quality;
+    crate::create_output_folder(dir)?;
+    let (w, h) = (r.width.min(320), r.height.min(240));
+    let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");
+    let report = render_quality::measure(frame, w, h, &render_quality::STEPS, || bar.inc(1));
+    let (hw, hh) = (w.min(160), h.min(120));
+    let hp = render_quality::measure_highpass(frame, hw, hh);
     bar.finish_and_clear();
+    render_quality::write(&report, dir)?;
+    render_quality::write_highpass(&hp, dir)?;
+    println!(
+        "reference ({} steps) took {:.2} s at {w}x{h}",
+        render_quality::REFERENCE_STEPS,
+        report.reference_wall_s
+    );
+    println!(
+        "{:>6} {:>9} {:>11} {:>10}",
+        "steps", "wall_s", "mean_error", "max_error"
+    );
+    for row in &report.rows {
+        println!(
+            "{:>6} {:>9.4} {:>11.5} {:>10.4}",
+            row.steps, row.wall_s, row.mean_error, row.max_error
+        );
+    }
+    match report.chosen {
+        Some(i) => println!(
+            "least-cost step count with mean error <= {}: {}",
+            render_quality::TARGET_MEAN_ERROR,
+            report.rows[i].steps
+        ),
+        None => println!(
+            "no step count reached mean error <= {}",
+            render_quality::TARGET_MEAN_ERROR
+        ),
+    }
+    println!(
+        "high-pass energy of {} cloud pixels at {hw}x{hh}, against {} steps x {} frames: \
+         one frame {:.2}x, {} frames averaged (TSAA) {:.2}x",
+        hp.cloud_pixels,
+        render_quality::HIGHPASS_REFERENCE_STEPS,
+        cumulus::render::sampling::JITTER_CYCLE,
+        hp.one_frame_ratio(),
+        cumulus::render::sampling::JITTER_CYCLE,
+        hp.converged_ratio()
+    );
+    println!(
+        "wrote {0}/render_quality.csv, {0}/render_quality.png and {0}/highpass.csv",
+        dir.display()
+    );
+    Ok(())
+}
+
+/// The CPU reference's still of the cloud map's clouds, written to `out`.
+fn render_cpu(
+    a: &RenderArgs,
+    scene: &Scene,
+    prepared: &Prepared,
+    quality: Quality,
+    out: &Path,
+    picture: Option<Picture>,
+) -> Result<()> {
+    use cumulus::render::cpu::stills::{add_sun_glare, render_still};
     let r = &scene.render;
-    let quality = Quality {
-        single_scattering: a.single_scattering,
-        ..r.quality()
-    };
-    if let Some(dir) = &a.quality_report {
-        // The CPU's frame, its light volume built once here (the GPU
-        // builds its own: a GPU picture does not wait for the CPU's).
-        let frame = prepared.frame(r, quality);
-        crate::create_output_folder(dir)?;
-        let (w, h) = (r.width.min(320), r.height.min(240));
-        let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");
-        let report = render_quality::measure(&frame, w, h, &render_quality::STEPS, || bar.inc(1));
-        let (hw, hh) = (w.min(160), h.min(120));
-        let hp = render_quality::measure_highpass(&frame, hw, hh);
-        bar.finish_and_clear();
-        render_quality::write(&report, dir)?;
-        render_quality::write_highpass(&hp, dir)?;
-        println!(
-            "reference ({} steps) took {:.2} s at {w}x{h}",
-            render_quality::REFERENCE_STEPS,
-            report.reference_wall_s
-        );
-        println!(
-            "{:>6} {:>9} {:>11} {:>10}",
-            "steps", "wall_s", "mean_error", "max_error"
-        );
-        for row in &report.rows {
-            println!(
-                "{:>6} {:>9.4} {:>11.5} {:>10.4}",
-                row.steps, row.wall_s, row.mean_error, row.max_error
-            );
-        }
-        match report.chosen {
-            Some(i) => println!(
-                "least-cost step count with mean error <= {}: {}",
-                render_quality::TARGET_MEAN_ERROR,
-                report.rows[i].steps
-            ),
-            None => println!(
-                "no step count reached mean error <= {}",
-                render_quality::TARGET_MEAN_ERROR
-            ),
-        }
-        println!(
-            "high-pass energy of {} cloud pixels at {hw}x{hh}, against {} steps x {} frames: \
-             one frame {:.2}x, {} frames averaged (TSAA) {:.2}x",
-            hp.cloud_pixels,
-            render_quality::HIGHPASS_REFERENCE_STEPS,
-            cumulus::render::sampling::JITTER_CYCLE,
-            hp.one_frame_ratio(),
-            cumulus::render::sampling::JITTER_CYCLE,
-            hp.converged_ratio()
-        );
-        println!(
-            "wrote {0}/render_quality.csv, {0}/render_quality.png and {0}/highpass.csv",
-            dir.display()
-        );
-    }
-    if r.renderer == RenderMethod::Spheroids {
-        return render_spheroids(gpu.as_ref(), &a, &scene, &prepared, picture);
-    }
-    if let Some(ctx) = &gpu {
-        return render_gpu(ctx, &a, &scene, &prepared, picture);
-    }
-    let Some(out) = &a.out else { return Ok(()) };
     let built = std::time::Instant::now();
     let frame = prepared.frame(r, quality);
     let light_s = built.elapsed().as_secs_f64();
