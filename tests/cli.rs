@@ -4,113 +4,187 @@
 
 mod common;
 
-use std::path::PathBuf;
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn cumulus(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cumulus"))
-        .args(args)
-        .output()
-        .expect("binary runs")
+/// The binary with `args`, not yet run.
+fn cumulus(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_cumulus"));
+    c.args(args);
+    c
 }
 
-fn root() -> PathBuf {
+/// `cumulus COMMAND --scene SCENE --out OUT`, then `extra`.
+fn on_scene(
+    command: &str,
+    scene: impl AsRef<OsStr>,
+    out: impl AsRef<OsStr>,
+    extra: &[&str],
+) -> Command {
+    let mut c = cumulus(&[command, "--scene"]);
+    c.arg(scene).arg("--out").arg(out).args(extra);
+    c
+}
+
+/// `render` with 16 light photons (quick), then `extra`.
+fn render(scene: impl AsRef<OsStr>, out: impl AsRef<OsStr>, extra: &[&str]) -> Command {
+    let mut c = on_scene("render", scene, out, &["--light-photons", "16"]);
+    c.args(extra);
+    c
+}
+
+/// `cumulus simulate --scene SCENE --out OUT`, then `extra`.
+fn simulate(scene: impl AsRef<OsStr>, out: impl AsRef<OsStr>, extra: &[&str]) -> Command {
+    on_scene("simulate", scene, out, extra)
+}
+
+/// A file shipped under `scenes/`.
+fn shipped(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().expect("a UTF-8 path")
 }
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// Runs `simulate` on a scene written to a temp dir; asserts failure with a
-/// message containing every `needle`, no panic, no output file.
-fn assert_simulate_fails(scene: &str, sounding: Option<&str>, needles: &[&str]) {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene_path = dir.path().join("bad.toml");
-    std::fs::write(&scene_path, scene).expect("write scene");
-    if let Some(s) = sounding {
-        std::fs::write(dir.path().join("snd.csv"), s).expect("write sounding");
-    }
-    let out = dir.path().join("curves.csv");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        scene_path.to_str().unwrap(),
-        "--duration-s",
-        "10",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "should fail: {err}");
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "clean error exit, not a panic (101): {err}"
-    );
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "stderr lacks `{n}`: {err}");
-    }
-    assert!(!out.exists(), "no output file on error");
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(
-        leftovers.len(),
-        1 + usize::from(sounding.is_some()),
-        "no temp files left: {leftovers:?}"
-    );
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
-const GOOD_SOUNDING: &str =
-    "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n1000,,12,8\n3000,,0,-5\n";
+/// Writes `text` to `name` in `dir`; returns its path.
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write file");
+    p
+}
+
+/// The names in `dir`, sorted.
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
+        .expect("read dir")
+        .map(|e| {
+            e.expect("dir entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// Runs `cmd`, which must succeed.
+fn succeeds(cmd: &mut Command) -> Output {
+    succeeds_saying(cmd, &[])
+}
+
+/// Runs `cmd`, which must succeed with every needle in its stderr.
+fn succeeds_saying(cmd: &mut Command, needles: &[&str]) -> Output {
+    let o = cmd.output().expect("binary runs");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{cmd:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "{cmd:?}: stderr lacks `{n}`: {err}");
+    }
+    o
+}
+
+/// A failed run `run` (named in the messages) must have exited with `code`
+/// (a clean error, not a panic's 101), without "panicked", with every
+/// needle in its stderr, which it returns.
+fn assert_failed(run: &str, o: &Output, code: i32, needles: &[&str]) -> String {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(code), "{run}: {err}");
+    assert!(!err.contains("panicked"), "{run}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "{run}: stderr lacks `{n}`: {err}");
+    }
+    err
+}
+
+/// Runs `cmd`, which must fail as `assert_failed` says; returns stderr.
+fn fails(cmd: &mut Command, code: i32, needles: &[&str]) -> String {
+    let o = cmd.output().expect("binary runs");
+    assert_failed(&format!("{cmd:?}"), &o, code, needles)
+}
+
+/// Runs `simulate` on `scene` (written as `bad.toml`, with `sounding`
+/// beside it as `snd.csv` where given); asserts a clean failure naming
+/// every needle, and no output or temporary file left.
+fn assert_simulate_fails(scene: &str, sounding: Option<&str>, needles: &[&str]) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene_path = write(dir.path(), "bad.toml", scene);
+    let mut kept = vec!["bad.toml"];
+    if let Some(s) = sounding {
+        write(dir.path(), "snd.csv", s);
+        kept.push("snd.csv");
+    }
+    let out = dir.path().join("curves.csv");
+    let o = simulate(&scene_path, &out, &["--duration-s", "10"])
+        .output()
+        .expect("binary runs");
+    let run = format!("simulate on {scene:?} with sounding {sounding:?}");
+    assert_failed(&run, &o, 1, needles);
+    assert_eq!(names_in(dir.path()), kept, "{run}: no output or temp file");
+}
+
+/// `assert_simulate_fails` for each (scene, needles), without a sounding.
+fn simulate_refuses(cases: &[(&str, &[&str])]) {
+    for (scene, needles) in cases {
+        assert_simulate_fails(scene, None, needles);
+    }
+}
+
+/// Writes `text` to `name` in `dir`; `scene check` on it must fail cleanly
+/// (exit 1) naming every needle.
+fn assert_scene_check_fails(dir: &Path, name: &str, text: &str, needles: &[&str]) {
+    let o = cumulus(&["scene", "check", path(&write(dir, name, text))])
+        .output()
+        .expect("binary runs");
+    assert_failed(&format!("scene check on {text:?}"), &o, 1, needles);
+}
 
 #[test]
 fn simulate_refuses_the_automaton_and_bad_methods_clearly() {
-    assert_simulate_fails(
-        "[simulation]\nmethod = \"automaton\"\n",
-        None,
-        &["bad.toml", "automaton", "no parcels"],
-    );
-    assert_simulate_fails(
-        "[simulation]\nmethod = \"voxels\"\n",
-        None,
-        &["bad.toml:2:", "parcels", "automaton", "endless"],
-    );
-    assert_simulate_fails(
-        "[simulation.endless]\ncells = [4, 4000, 4]\n",
-        None,
-        &["bad.toml:2:", "simulation.endless.cells"],
-    );
+    simulate_refuses(&[
+        (
+            "[simulation]\nmethod = \"automaton\"\n",
+            &["bad.toml", "automaton", "no parcels"],
+        ),
+        (
+            "[simulation]\nmethod = \"voxels\"\n",
+            &["bad.toml:2:", "parcels", "automaton", "endless"],
+        ),
+        (
+            "[simulation.endless]\ncells = [4, 4000, 4]\n",
+            &["bad.toml:2:", "simulation.endless.cells"],
+        ),
+    ]);
 }
 
+/// Malformed TOML names the file and line; an unknown, negative or NaN
+/// value also its key.
 #[test]
-fn malformed_toml_names_file_and_line() {
-    assert_simulate_fails(
-        "name = \"x\"\n[physics\nparcels = 3\n",
-        None,
-        &["bad.toml:2:"],
-    );
-}
-
-#[test]
-fn unknown_key_names_file_line_and_key() {
-    assert_simulate_fails(
-        "[physics]\nparcels = 3\nradiuss_m = 5\n",
-        None,
-        &["bad.toml:3:", "radiuss_m"],
-    );
-}
-
-#[test]
-fn negative_radius_names_key() {
-    assert_simulate_fails(
-        "[physics]\nradius_m = -300\n",
-        None,
-        &["bad.toml:2", "physics.radius_m", "-300"],
-    );
+fn bad_scene_values_name_file_line_and_key() {
+    simulate_refuses(&[
+        ("name = \"x\"\n[physics\nparcels = 3\n", &["bad.toml:2:"]),
+        (
+            "[physics]\nparcels = 3\nradiuss_m = 5\n",
+            &["bad.toml:3:", "radiuss_m"],
+        ),
+        (
+            "[physics]\nradius_m = -300\n",
+            &["bad.toml:2", "physics.radius_m", "-300"],
+        ),
+        ("[physics]\ndt_s = nan\n", &["bad.toml:2", "physics.dt_s"]),
+    ]);
 }
 
 /// A value past a key's upper bound gets an error that states the whole
@@ -118,16 +192,16 @@ fn negative_radius_names_key() {
 /// radius) both are.
 #[test]
 fn out_of_range_errors_state_the_range() {
-    assert_simulate_fails(
-        "[physics]\nradius_m = 200000\n",
-        None,
-        &["bad.toml:2", "physics.radius_m", "200000", "1e-3..=1e5 m"],
-    );
-    assert_simulate_fails(
-        "[physics.recycling]\nmax_age_s = 1e10\n",
-        None,
-        &["bad.toml:2", "physics.recycling.max_age_s", "1e-3..=1e9 s"],
-    );
+    simulate_refuses(&[
+        (
+            "[physics]\nradius_m = 200000\n",
+            &["bad.toml:2", "physics.radius_m", "200000", "1e-3..=1e5 m"],
+        ),
+        (
+            "[physics.recycling]\nmax_age_s = 1e10\n",
+            &["bad.toml:2", "physics.recycling.max_age_s", "1e-3..=1e9 s"],
+        ),
+    ]);
     let dir = tempfile::tempdir().unwrap();
     for (key, value, range) in [
         ("exposure", "1e6", "0.001..=1000"),
@@ -139,49 +213,32 @@ fn out_of_range_errors_state_the_range() {
         ("detail_scale_m", "0", "1..=1e5 m"),
         ("detail_strength", "2", "0..=1"),
     ] {
-        let p = dir.path().join("s.toml");
-        std::fs::write(&p, format!("[render]\n{key} = {value}\n")).unwrap();
-        let o = cumulus(&["scene", "check", p.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(1), "{key}");
-        let e = stderr(&o);
-        assert!(
-            e.contains(&format!("s.toml:2: `render.{key}`")) && e.contains(range),
-            "{key}: {e}"
+        assert_scene_check_fails(
+            dir.path(),
+            "s.toml",
+            &format!("[render]\n{key} = {value}\n"),
+            &[&format!("s.toml:2: `render.{key}`"), range],
         );
     }
 }
 
+/// A bad sounding names its file and line (and column); a missing one its
+/// file.
 #[test]
-fn nan_field_is_rejected() {
-    assert_simulate_fails(
-        "[physics]\ndt_s = nan\n",
-        None,
-        &["bad.toml:2", "physics.dt_s"],
-    );
-}
-
-#[test]
-fn unsorted_sounding_names_line() {
-    let s = "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n900,,12,8\n800,,11,7\n";
-    assert_simulate_fails(
-        "[atmosphere]\nsounding = \"snd.csv\"\n",
-        Some(s),
-        &["snd.csv:4:", "strictly increasing"],
-    );
-}
-
-#[test]
-fn non_numeric_sounding_names_line_and_column() {
-    let s = "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n900,,twelve,8\n";
-    assert_simulate_fails(
-        "[atmosphere]\nsounding = \"snd.csv\"\n",
-        Some(s),
-        &["snd.csv:3:", "temperature_C", "twelve"],
-    );
-}
-
-#[test]
-fn missing_sounding_file_is_named() {
+fn bad_soundings_name_file_line_and_column() {
+    let scene = "[atmosphere]\nsounding = \"snd.csv\"\n";
+    for (sounding, needles) in [
+        (
+            "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n900,,12,8\n800,,11,7\n",
+            &["snd.csv:4:", "strictly increasing"][..],
+        ),
+        (
+            "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n900,,twelve,8\n",
+            &["snd.csv:3:", "temperature_C", "twelve"],
+        ),
+    ] {
+        assert_simulate_fails(scene, Some(sounding), needles);
+    }
     assert_simulate_fails(
         "[atmosphere]\nsounding = \"nowhere.csv\"\n",
         None,
@@ -190,75 +247,101 @@ fn missing_sounding_file_is_named() {
 }
 
 #[test]
-fn missing_scene_file_is_named() {
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        "/no/such/scene.toml",
-        "--out",
-        "/tmp/never.csv",
+fn a_bad_ground_names_its_key() {
+    simulate_refuses(&[
+        (
+            "[render.ground]\nsurface = \"lake\"\n",
+            &["bad.toml", "lake", "land", "sea"],
+        ),
+        (
+            "[render.ground]\nwind_speed_mps = 50.0\n",
+            &["bad.toml", "render.ground.wind_speed_mps", "0..=30"],
+        ),
+        (
+            "[render.ground]\nland = \"forest\"\n",
+            &["bad.toml", "forest", "fields", "plain"],
+        ),
     ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("/no/such/scene.toml"), "{}", stderr(&o));
 }
 
 #[test]
-fn bad_flag_value_is_an_error_after_overrides() {
+fn missing_scene_file_is_named() {
+    fails(
+        &mut simulate("/no/such/scene.toml", "/tmp/never.csv", &[]),
+        1,
+        &["/no/such/scene.toml"],
+    );
+}
+
+/// A bad flag or scene value is a clear error (exit 2 from the argument
+/// parser, 1 from the checks after it) that names it, and nothing is
+/// written.
+#[test]
+fn odd_values_get_clear_errors_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("c.csv");
-    let scene = root().join("scenes/bomex.toml");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--dt-s",
-        "0",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("physics.dt_s"), "{}", stderr(&o));
-    assert!(!out.exists());
+    let (fair, bomex) = (shipped("fair_weather.toml"), shipped("bomex.toml"));
+    // A camera so far away that nothing could be drawn.
+    let far = write(
+        dir.path(),
+        "far.toml",
+        "[render]\ncamera_position_m = [0, 1e9, 0]\n",
+    );
+    let [csv, png, stats] = ["c.csv", "x.png", "stats"].map(|n| dir.path().join(n));
+    for (mut cmd, code, needles) in [
+        // A flag's value is checked after it overrides the scene's.
+        (
+            simulate(&bomex, &csv, &["--dt-s", "0"]),
+            1,
+            &["physics.dt_s"][..],
+        ),
+        // A duration with no bound.
+        (
+            simulate(&fair, &csv, &["--duration-s", "1e15"]),
+            1,
+            &["--duration-s is 1000000000000000"],
+        ),
+        (
+            render(&fair, &png, &["--width", "-5"]),
+            2,
+            &["invalid value '-5' for '--width"],
+        ),
+        (render(&far, &png, &[]), 1, &["`render.camera_position_m`"]),
+        (render(&fair, &png, &["--steps", "0"]), 1, &["render.steps"]),
+        // Refused before simulating.
+        (
+            on_scene("stats", &fair, &stats, &["--resolution", "5"]),
+            1,
+            &["--resolution is 5"],
+        ),
+    ] {
+        fails(&mut cmd, code, needles);
+        assert_eq!(names_in(dir.path()), ["far.toml"], "{cmd:?} wrote a file");
+    }
+}
+
+/// Off a terminal, a run reports its progress in plain lines.
+#[test]
+fn off_a_terminal_a_run_reports_progress_in_plain_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("c.csv");
+    let extra = ["--parcels", "3", "--duration-s", "600"];
+    succeeds_saying(
+        &mut simulate(shipped("fair_weather.toml"), &csv, &extra),
+        &["simulating: 50 % (60 of 120)", "simulating: 100 %"],
+    );
 }
 
 #[test]
 fn simulate_writes_the_fig5_columns_for_every_parcel() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("curves.csv");
-    let scene = root().join("scenes/bomex.toml");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--duration-s",
-        "1200",
-        "--every-s",
-        "600",
-        "--parcels",
-        "5",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let extra = ["--duration-s", "1200", "--every-s", "600", "--parcels", "5"];
+    succeeds(&mut simulate(shipped("bomex.toml"), &out, &extra));
     let mut r = csv::Reader::from_path(&out).unwrap();
     let header = r.headers().unwrap().clone();
-    for col in [
-        "t_s",
-        "id",
-        "x_m",
-        "y_m",
-        "z_m",
-        "w_mps",
-        "theta_v_K",
-        "theta_v_env_K",
-        "T_K",
-        "qv_gkg",
-        "qc_gkg",
-        "qt_gkg",
-        "buoyancy_mps2",
-        "condensed_fraction",
-        "fill",
-    ] {
+    let columns = "t_s id x_m y_m z_m w_mps theta_v_K theta_v_env_K T_K qv_gkg qc_gkg qt_gkg \
+                   buoyancy_mps2 condensed_fraction fill";
+    for col in columns.split_whitespace() {
         assert!(header.iter().any(|h| h == col), "missing column {col}");
     }
     let rows: Vec<_> = r.records().map(|x| x.unwrap()).collect();
@@ -278,16 +361,15 @@ fn simulate_writes_the_fig5_columns_for_every_parcel() {
 fn profile_prints_lcl_and_writes_one_row_per_level() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("p.csv");
-    let snd = root().join("scenes/bomex_sounding.csv");
-    let o = cumulus(&[
+    let snd = shipped("bomex_sounding.csv");
+    let o = succeeds(&mut cumulus(&[
         "profile",
         "--sounding",
-        snd.to_str().unwrap(),
+        path(&snd),
         "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let stdout = String::from_utf8_lossy(&o.stdout);
+        path(&out),
+    ]));
+    let stdout = stdout(&o);
     let z: f64 = stdout
         .lines()
         .find_map(|l| l.strip_prefix("lcl_height_m="))
@@ -316,9 +398,8 @@ fn profile_prints_lcl_and_writes_one_row_per_level() {
 #[test]
 fn a_closed_pipe_on_stdout_ends_the_run_without_a_panic() {
     use std::process::Stdio;
-    let scene = root().join("scenes/fair_weather.toml");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_cumulus"))
-        .args(["scene", "check", scene.to_str().unwrap()])
+    let scene = shipped("fair_weather.toml");
+    let mut child = cumulus(&["scene", "check", path(&scene)])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -338,22 +419,11 @@ fn a_closed_pipe_on_stdout_ends_the_run_without_a_panic() {
 #[test]
 fn out_to_dev_stdout_appends_to_a_redirected_log() {
     let dir = tempfile::tempdir().unwrap();
-    let log = dir.path().join("log.txt");
-    std::fs::write(&log, "kept\n").unwrap();
+    let log = write(dir.path(), "log.txt", "kept\n");
     let file = std::fs::OpenOptions::new().append(true).open(&log).unwrap();
-    let snd = root().join("scenes/bomex_sounding.csv");
-    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
-        .args([
-            "profile",
-            "--sounding",
-            snd.to_str().unwrap(),
-            "--out",
-            "/dev/stdout",
-        ])
-        .stdout(file)
-        .output()
-        .expect("runs");
-    assert!(o.status.success(), "{}", stderr(&o));
+    let snd = shipped("bomex_sounding.csv");
+    let args = ["profile", "--sounding", path(&snd), "--out", "/dev/stdout"];
+    succeeds(cumulus(&args).stdout(file));
     let text = std::fs::read_to_string(&log).unwrap();
     assert!(text.starts_with("kept\nlcl_pressure_hPa="), "{text}");
     assert!(text.contains("\nheight_m,pressure_hPa,"), "{text}");
@@ -365,32 +435,25 @@ fn out_to_dev_stdout_appends_to_a_redirected_log() {
 #[test]
 fn profile_says_none_where_there_is_no_lcl() {
     let dir = tempfile::tempdir().unwrap();
-    let write = |name: &str, text: &str| {
-        let p = dir.path().join(name);
-        std::fs::write(&p, text).unwrap();
-        p
+    let profile = |name: &str, sounding: &str| {
+        let p = write(dir.path(), name, sounding);
+        let args = ["profile", "--sounding", path(&p)];
+        stdout(&succeeds(&mut cumulus(&args)))
     };
-    let lines = |p: &std::path::Path| {
-        let o = cumulus(&["profile", "--sounding", p.to_str().unwrap()]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        String::from_utf8_lossy(&o.stdout).into_owned()
-    };
-    let dry = write(
+    let out = profile(
         "dry.csv",
         "height_m,pressure_hPa,temperature_C,relative_humidity_pct\n0,1000,25,0\n500,950,20,0\n",
     );
-    let out = lines(&dry);
     for key in ["lcl_pressure_hPa", "lcl_temperature_K", "lcl_height_m"] {
         assert!(out.contains(&format!("{key}=none (")), "{out}");
     }
     assert!(out.contains("never saturates"), "{out}");
     // Moist air whose LCL lies above a short sounding: its pressure and
     // temperature (as MetPy's `lcl` gives them), no height, and why.
-    let short = write(
+    let out = profile(
         "short.csv",
         "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,25,15\n100,988.5,24,14.8\n",
     );
-    let out = lines(&short);
     let p: f64 = out
         .lines()
         .find_map(|l| l.strip_prefix("lcl_pressure_hPa="))
@@ -408,81 +471,67 @@ fn profile_says_none_where_there_is_no_lcl() {
 
 #[test]
 fn scene_check_accepts_shipped_scenes_and_rejects_bad_ones() {
-    for s in ["bomex", "fair_weather", "strong_inversion"] {
-        let o = cumulus(&[
-            "scene",
-            "check",
-            root().join(format!("scenes/{s}.toml")).to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{s}: {}", stderr(&o));
+    for s in ["bomex.toml", "fair_weather.toml", "strong_inversion.toml"] {
+        succeeds(&mut cumulus(&["scene", "check", path(&shipped(s))]));
     }
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("s.toml");
-    std::fs::write(&p, "[physics.sph]\nsound_speed_mps = -1\n").unwrap();
-    let o = cumulus(&["scene", "check", p.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stderr(&o).contains("s.toml:2: `physics.sph.sound_speed_mps`"),
-        "{}",
-        stderr(&o)
+    assert_scene_check_fails(
+        dir.path(),
+        "s.toml",
+        "[physics.sph]\nsound_speed_mps = -1\n",
+        &["s.toml:2: `physics.sph.sound_speed_mps`"],
     );
 }
 
 #[test]
 fn sounding_flag_replaces_the_scene_atmosphere() {
     let dir = tempfile::tempdir().unwrap();
-    let snd = dir.path().join("good.csv");
-    std::fs::write(&snd, GOOD_SOUNDING).unwrap();
-    let out = dir.path().join("c.csv");
-    let scene = root().join("scenes/fair_weather.toml");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--sounding",
-        snd.to_str().unwrap(),
-        "--duration-s",
-        "60",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    // The environment comes from the 3-level sounding: θ_v,env at the
-    // release height (50 m) is that of 20 °C at ~994 hPa with 15 °C dewpoint.
-    let mut r = csv::Reader::from_path(&out).unwrap();
-    let h = r.headers().unwrap().clone();
-    let col = h.iter().position(|c| c == "theta_v_env_K").unwrap();
-    let row = r.records().next().unwrap().unwrap();
-    let thv: f64 = row[col].parse().unwrap();
-    assert!((thv - 295.2).abs() < 1.0, "θ_v,env {thv}");
+    let snd = write(
+        dir.path(),
+        "good.csv",
+        "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n1000,,12,8\n3000,,0,-5\n",
+    );
+    // θ_v of the environment at the first parcel's release height (50 m)
+    // in the first row, with and without the flag.
+    let theta_v_env = |extra: &[&str], name: &str| -> f64 {
+        let out = dir.path().join(name);
+        succeeds(&mut simulate(shipped("fair_weather.toml"), &out, extra));
+        let mut r = csv::Reader::from_path(&out).unwrap();
+        let h = r.headers().unwrap().clone();
+        let col = h.iter().position(|c| c == "theta_v_env_K").unwrap();
+        let z = h.iter().position(|c| c == "z_m").unwrap();
+        let row = r.records().next().unwrap().unwrap();
+        assert_eq!(row[z].parse::<f64>().unwrap(), 50.0, "released at 50 m");
+        row[col].parse().unwrap()
+    };
+    let with = theta_v_env(
+        &["--sounding", path(&snd), "--duration-s", "60"],
+        "with.csv",
+    );
+    let without = theta_v_env(&["--duration-s", "60"], "without.csv");
+    // By hand from the 3-level sounding: at 50 m 19.6 °C with a 14.65 °C
+    // dewpoint, 994.2 hPa from the hydrostatic fill, so a mixing ratio of
+    // 10.6 g/kg and θ_v 295.13 K (Bolton's saturation pressure; the code's
+    // Ambaum differs by 0.01 K). The scene's own atmosphere gives 296.1 K.
+    assert!(
+        (with - 295.13).abs() < 0.05,
+        "θ_v,env {with} with --sounding"
+    );
+    assert!(
+        (with - without).abs() > 0.5,
+        "--sounding changed nothing: {with} K against the scene's {without} K"
+    );
 }
 
 #[test]
 fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = root().join("scenes/fair_weather.toml");
+    let scene = shipped("fair_weather.toml");
     let run = |name: &str| {
         let out = dir.path().join(name);
-        let o = cumulus(&[
-            "render",
-            "--light-photons",
-            "16",
-            "--scene",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--width",
-            "96",
-            "--height",
-            "72",
-            "--backend",
-            "cpu",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        assert!(
-            stderr(&o).contains("backend: cpu"),
-            "says which backend it used"
-        );
+        let extra = ["--width", "96", "--height", "72", "--backend", "cpu"];
+        // It says which backend it used.
+        succeeds_saying(&mut render(&scene, &out, &extra), &["backend: cpu"]);
         std::fs::read(out).unwrap()
     };
     let (a, b) = (run("a.png"), run("b.png"));
@@ -513,59 +562,20 @@ fn render_writes_a_deterministic_sky_png_and_refuses_missing_backends() {
     // is a clear error that says how to get one; auto falls back to the CPU
     // and says why.
     let out = dir.path().join("gpu.png");
-    let args = [
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--width",
-        "32",
-        "--height",
-        "24",
-    ];
     let no_adapter = |backend: &str| {
-        let mut a = args.to_vec();
-        a.extend(["--backend", backend]);
-        Command::new(env!("CARGO_BIN_EXE_cumulus"))
-            .args(&a)
-            .env("WGPU_BACKEND", if cfg!(windows) { "metal" } else { "dx12" })
-            .output()
-            .expect("binary runs")
+        let extra = ["--width", "32", "--height", "24", "--backend", backend];
+        let mut c = render(&scene, &out, &extra);
+        c.env("WGPU_BACKEND", if cfg!(windows) { "metal" } else { "dx12" });
+        c
     };
-    let o = no_adapter("gpu");
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stderr(&o).contains("no GPU adapter") && stderr(&o).contains("--backend cpu"),
-        "{}",
-        stderr(&o)
+    fails(
+        &mut no_adapter("gpu"),
+        1,
+        &["no GPU adapter", "--backend cpu"],
     );
     assert!(!out.exists());
-    let o = no_adapter("auto");
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("backend: cpu (no GPU adapter"),
-        "{}",
-        stderr(&o)
-    );
-    std::fs::remove_file(&out).unwrap();
-    assert!(!out.exists());
-    let o = cumulus(&[
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--steps",
-        "0",
-    ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("render.steps"), "{}", stderr(&o));
-    assert!(!out.exists());
+    succeeds_saying(&mut no_adapter("auto"), &["backend: cpu (no GPU adapter"]);
+    assert!(out.is_file());
 }
 
 #[test]
@@ -575,29 +585,13 @@ fn render_on_the_gpu_writes_the_png_and_times_frames() {
     }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("gpu.png");
-    let scene = root().join("scenes/fair_weather.toml");
-    let o = cumulus(&[
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--width",
-        "40",
-        "--height",
-        "30",
-        "--backend",
-        "gpu",
-        "--frames",
-        "3",
-        "--time-frames",
-        "2",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("backend: gpu"), "{}", stderr(&o));
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let extra = ["--backend", "gpu", "--frames", "3", "--time-frames", "2"];
+    let mut c = render(shipped("fair_weather.toml"), &out, &extra);
+    let o = succeeds_saying(
+        c.args(["--width", "40", "--height", "30"]),
+        &["backend: gpu"],
+    );
+    let stdout = stdout(&o);
     assert!(stdout.contains("frame 40x30: median"), "{stdout}");
     let img = image::open(&out).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (40, 30));
@@ -609,25 +603,10 @@ fn render_on_the_gpu_writes_the_png_and_times_frames() {
 fn a_step_that_does_not_divide_the_duration_simulates_exactly_the_duration() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("curves.csv");
-    let scene = root().join("scenes/fair_weather.toml");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--parcels",
-        "3",
-        "--dt-s",
-        "7",
-        "--duration-s",
-        "60",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
-    assert!(
-        err.contains("simulated 60 s in 9 frames (8 of 7 s, the last of 4 s)"),
-        "{err}"
+    let extra = ["--parcels", "3", "--dt-s", "7", "--duration-s", "60"];
+    succeeds_saying(
+        &mut simulate(shipped("fair_weather.toml"), &out, &extra),
+        &["simulated 60 s in 9 frames (8 of 7 s, the last of 4 s)"],
     );
     let text = std::fs::read_to_string(&out).unwrap();
     let last_t: f64 = text
@@ -643,20 +622,10 @@ fn a_step_that_does_not_divide_the_duration_simulates_exactly_the_duration() {
 fn stats_writes_the_field_statistics() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("stats");
-    let scene = root().join("scenes/fair_weather.toml");
-    let o = cumulus(&[
-        "stats",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--resolution",
-        "96",
-        "--levels",
-        "12",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let scene = shipped("fair_weather.toml");
+    let extra = ["--resolution", "96", "--levels", "12"];
+    let o = succeeds(&mut on_scene("stats", &scene, &out, &extra));
+    let stdout = stdout(&o);
     assert!(stdout.contains("cloud_fraction="), "{stdout}");
     for f in [
         "clouds.csv",
@@ -676,47 +645,15 @@ fn stats_writes_the_field_statistics() {
 }
 
 #[test]
-fn stats_rejects_a_bad_resolution_before_simulating() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("stats");
-    let scene = root().join("scenes/fair_weather.toml");
-    let o = cumulus(&[
-        "stats",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--resolution",
-        "5",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("--resolution is 5"), "{}", stderr(&o));
-    assert!(!out.exists());
-}
-
-#[test]
 fn render_refuses_a_missing_folder_or_a_directory_before_simulating() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = root().join("scenes/fair_weather.toml");
+    let scene = shipped("fair_weather.toml");
     let missing = dir.path().join("no/such/folder/sky.png");
     for (out, says) in [
         (missing.as_path(), "does not exist"),
         (dir.path(), "is a directory"),
     ] {
-        let o = cumulus(&[
-            "render",
-            "--light-photons",
-            "16",
-            "--scene",
-            scene.to_str().unwrap(),
-            "--backend",
-            "cpu",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_eq!(o.status.code(), Some(1));
-        let err = stderr(&o);
-        assert!(err.contains(says), "{err}");
+        let err = fails(&mut render(&scene, out, &["--backend", "cpu"]), 1, &[says]);
         // Refused up front: nothing was simulated or rendered.
         assert!(
             !err.contains("backend:") && !err.contains("rendered"),
@@ -732,24 +669,14 @@ fn render_refuses_a_missing_folder_or_a_directory_before_simulating() {
 fn a_successful_render_prints_no_error_and_one_backend_line() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("sky.png");
-    let scene = root().join("scenes/fair_weather.toml");
-    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
-        .args([
-            "render",
-            "--light-photons",
-            "16",
-            "--scene",
-            scene.to_str().unwrap(),
-            "--backend",
-            "auto",
-        ])
-        .args(["--width", "32", "--height", "24", "--time-s", "60", "--out"])
-        .arg(&out)
-        .env_remove("XDG_RUNTIME_DIR")
-        .output()
-        .expect("runs");
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
+    let mut c = render(
+        shipped("fair_weather.toml"),
+        &out,
+        &["--backend", "auto", "--time-s", "60"],
+    );
+    c.args(["--width", "32", "--height", "24"])
+        .env_remove("XDG_RUNTIME_DIR");
+    let err = stderr(&succeeds(&mut c));
     assert!(!err.to_lowercase().contains("error"), "{err}");
     assert_eq!(err.matches("backend:").count(), 1, "{err}");
 }
@@ -768,150 +695,42 @@ fn every_help_shows_an_example() {
         &["export"],
         &["scene", "check"],
     ] {
-        let mut args = cmd.to_vec();
-        args.push("--help");
-        let o = cumulus(&args);
-        assert!(o.status.success(), "{cmd:?}");
-        let text = String::from_utf8_lossy(&o.stdout);
+        let text = stdout(&succeeds(cumulus(cmd).arg("--help")));
         assert!(text.contains("Example:\n  cumulus "), "{cmd:?}:\n{text}");
+        if cmd == ["render"] {
+            assert!(text.contains("unless --quality-report"), "{text}");
+        }
     }
-    let o = cumulus(&["render", "--help"]);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("unless --quality-report"));
 }
 
 /// Errors say where the bad value came from, once.
 #[test]
 fn errors_name_where_the_value_came_from() {
     let dir = tempfile::tempdir().unwrap();
-    let write = |name: &str, text: &str| {
-        let p = dir.path().join(name);
-        std::fs::write(&p, text).unwrap();
-        p
-    };
     // A missing scene: the OS error once.
-    let o = cumulus(&["scene", "check", "nothere.toml"]);
-    assert_eq!(o.status.code(), Some(1));
-    assert_eq!(
-        stderr(&o).matches("No such file").count(),
-        1,
-        "{}",
-        stderr(&o)
-    );
+    let err = fails(&mut cumulus(&["scene", "check", "nothere.toml"]), 1, &[]);
+    assert_eq!(err.matches("No such file").count(), 1, "{err}");
     // A missing sounding: the scene file, line and key that name it.
-    let s = write(
+    assert_scene_check_fails(
+        dir.path(),
         "s1.toml",
         "name = \"x\"\n[atmosphere]\nsounding = \"missing.csv\"\n",
-    );
-    let o = cumulus(&["scene", "check", s.to_str().unwrap()]);
-    let err = stderr(&o);
-    assert!(
-        err.contains("s1.toml:3: `atmosphere.sounding`: names") && err.contains("missing.csv"),
-        "{err}"
+        &["s1.toml:3: `atmosphere.sounding`: names", "missing.csv"],
     );
     // A flag's value: the flag, not a line of the scene.
-    let s = write("s2.toml", "[physics]\nparcels = 12\n");
-    let out = dir.path().join("c.csv");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        s.to_str().unwrap(),
-        "--parcels",
-        "10000000",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let err = stderr(&o);
-    assert!(
-        err.contains("--parcels is 10000000, expected 0..=200000"),
-        "{err}"
+    let s = write(dir.path(), "s2.toml", "[physics]\nparcels = 12\n");
+    let err = fails(
+        &mut simulate(&s, dir.path().join("c.csv"), &["--parcels", "10000000"]),
+        1,
+        &["--parcels is 10000000, expected 0..=200000"],
     );
     assert!(!err.contains("s2.toml:2"), "{err}");
     // A TOML type error: the key.
-    let s = write("s3.toml", "[physics]\nparcels = \"many\"\n");
-    let o = cumulus(&["scene", "check", s.to_str().unwrap()]);
-    assert!(
-        stderr(&o).contains("s3.toml:2:11: `physics.parcels`: invalid type"),
-        "{}",
-        stderr(&o)
-    );
-}
-
-#[test]
-fn odd_values_get_clear_errors() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("x.png");
-    let scene = root().join("scenes/fair_weather.toml");
-    let sc = scene.to_str().unwrap();
-    let o = cumulus(&[
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        sc,
-        "--width",
-        "-5",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("invalid value '-5' for '--width"),
-        "{}",
-        stderr(&o)
-    );
-    // A camera so far away that nothing could be drawn.
-    let far = dir.path().join("far.toml");
-    std::fs::write(&far, "[render]\ncamera_position_m = [0, 1e9, 0]\n").unwrap();
-    let o = cumulus(&[
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        far.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stderr(&o).contains("`render.camera_position_m`"),
-        "{}",
-        stderr(&o)
-    );
-    assert!(!out.exists());
-    // A duration with no bound.
-    let csv = dir.path().join("c.csv");
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        sc,
-        "--duration-s",
-        "1e15",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stderr(&o).contains("--duration-s is 1000000000000000"),
-        "{}",
-        stderr(&o)
-    );
-    // Off a terminal, a run reports its progress in plain lines.
-    let o = cumulus(&[
-        "simulate",
-        "--scene",
-        sc,
-        "--parcels",
-        "3",
-        "--duration-s",
-        "600",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
-    assert!(
-        err.contains("simulating: 50 % (60 of 120)") && err.contains("simulating: 100 %"),
-        "{err}"
+    assert_scene_check_fails(
+        dir.path(),
+        "s3.toml",
+        "[physics]\nparcels = \"many\"\n",
+        &["s3.toml:2:11: `physics.parcels`: invalid type"],
     );
 }
 
@@ -921,15 +740,12 @@ fn odd_values_get_clear_errors() {
 #[test]
 fn interrupted_runs_leave_no_temporary_file() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = root().join("scenes/fair_weather.toml");
+    let scene = shipped("fair_weather.toml");
     let out = dir.path().join("curves.csv");
     let stale = dir.path().join(format!(".curves.csv.{}.tmp", u32::MAX));
     std::fs::write(&stale, "left by a killed run").unwrap();
     for signal in ["-INT", "-TERM"] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_cumulus"))
-            .args(["simulate", "--scene", scene.to_str().unwrap()])
-            .args(["--parcels", "400", "--duration-s", "1e6", "--out"])
-            .arg(&out)
+        let mut child = simulate(&scene, &out, &["--parcels", "400", "--duration-s", "1e6"])
             .stderr(std::process::Stdio::piped())
             .spawn()
             .expect("runs");
@@ -966,69 +782,26 @@ fn interrupted_runs_leave_no_temporary_file() {
 #[test]
 fn shipped_scenes_work_outside_the_repository() {
     let dir = tempfile::tempdir().unwrap();
-    let render = |scene: &str| {
-        Command::new(env!("CARGO_BIN_EXE_cumulus"))
-            .args([
-                "render",
-                "--light-photons",
-                "16",
-                "--scene",
-                scene,
-                "--backend",
-                "cpu",
-                "--out",
-                "sky.png",
-            ])
-            .args(["--width", "16", "--height", "12", "--time-s", "10"])
-            .current_dir(dir.path())
-            .output()
-            .expect("runs")
+    let render_here = |scene: &str| {
+        let mut c = render(scene, "sky.png", &["--backend", "cpu", "--time-s", "10"]);
+        c.args(["--width", "16", "--height", "12"])
+            .current_dir(dir.path());
+        c
     };
-    let o = render("scenes/fair_weather.toml");
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("using the built-in copy"),
-        "{}",
-        stderr(&o)
-    );
+    let built_in = ["using the built-in copy"];
+    succeeds_saying(&mut render_here("scenes/fair_weather.toml"), &built_in);
     assert!(dir.path().join("sky.png").is_file());
     // Not a shipped scene's name: the usual error.
-    let o = render("scenes/mine.toml");
-    assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("cannot read scene"), "{}", stderr(&o));
+    fails(
+        &mut render_here("scenes/mine.toml"),
+        1,
+        &["cannot read scene"],
+    );
     // `scene check` reads a scene as the other commands do (it said "No
     // such file" for the name `render` takes).
-    let o = Command::new(env!("CARGO_BIN_EXE_cumulus"))
-        .args(["scene", "check", "scenes/fair_weather.toml"])
-        .current_dir(dir.path())
-        .output()
-        .expect("runs");
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("using the built-in copy"),
-        "{}",
-        stderr(&o)
-    );
-    assert!(String::from_utf8_lossy(&o.stdout).contains(": ok ("));
-}
-
-#[test]
-fn a_bad_ground_names_its_key() {
-    assert_simulate_fails(
-        "[render.ground]\nsurface = \"lake\"\n",
-        None,
-        &["bad.toml", "lake", "land", "sea"],
-    );
-    assert_simulate_fails(
-        "[render.ground]\nwind_speed_mps = 50.0\n",
-        None,
-        &["bad.toml", "render.ground.wind_speed_mps", "0..=30"],
-    );
-    assert_simulate_fails(
-        "[render.ground]\nland = \"forest\"\n",
-        None,
-        &["bad.toml", "forest", "fields", "plain"],
-    );
+    let mut check = cumulus(&["scene", "check", "scenes/fair_weather.toml"]);
+    let o = succeeds_saying(check.current_dir(dir.path()), &built_in);
+    assert!(stdout(&o).contains(": ok ("));
 }
 
 #[test]
@@ -1041,31 +814,16 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
         )
     };
     let path = dir.path().join("e.toml");
-    let render = |out: &str| {
-        let o = cumulus(&[
-            "render",
-            "--light-photons",
-            "16",
-            "--scene",
-            path.to_str().unwrap(),
-            "--backend",
-            "cpu",
-            "--width",
-            "32",
-            "--height",
-            "24",
-            "--out",
-            dir.path().join(out).to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        stderr(&o)
+    let render_into = |out: &str| {
+        let extra = ["--backend", "cpu", "--width", "32", "--height", "24"];
+        stderr(&succeeds(&mut render(&path, dir.path().join(out), &extra)))
     };
     std::fs::write(&path, scene(0.6)).unwrap();
     assert!(
-        render("a.png").contains("wrote"),
+        render_into("a.png").contains("wrote"),
         "first run builds and writes"
     );
-    let second = render("b.png");
+    let second = render_into("b.png");
     assert!(second.contains("read from"), "{second}");
     assert_eq!(
         std::fs::read(dir.path().join("a.png")).unwrap(),
@@ -1073,29 +831,17 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
         "the read database draws the same picture"
     );
     std::fs::write(&path, scene(0.5)).unwrap();
-    let third = render("c.png");
+    let third = render_into("c.png");
     assert!(
         third.contains("built") && third.contains("wrote"),
         "{third}"
     );
     // A file that is not a database is an error, never overwritten.
     std::fs::write(dir.path().join("sky.volumes"), "not volumes").unwrap();
-    let o = cumulus(&[
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        path.to_str().unwrap(),
-        "--backend",
-        "cpu",
-        "--out",
-        dir.path().join("d.png").to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("not a cumulus volume database"),
-        "{}",
-        stderr(&o)
+    fails(
+        &mut render(&path, dir.path().join("d.png"), &["--backend", "cpu"]),
+        1,
+        &["not a cumulus volume database"],
     );
     assert_eq!(
         std::fs::read(dir.path().join("sky.volumes")).unwrap(),
@@ -1105,29 +851,13 @@ fn an_endless_database_is_written_once_then_read_and_rebuilt_for_new_settings() 
 
 /// `render`s `scene` into `out` as a 48x36 CPU picture, with `extra`
 /// flags; asserts success and reads the picture back.
-fn render_small_cpu(
-    scene: &std::path::Path,
-    out: &std::path::Path,
-    extra: &[&str],
-) -> image::RgbImage {
-    let mut args = vec![
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--width",
-        "48",
-        "--height",
-        "36",
-        "--backend",
-        "cpu",
-    ];
-    args.extend_from_slice(extra);
-    let o = cumulus(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+fn render_small_cpu(scene: &Path, out: &Path, extra: &[&str]) -> image::RgbImage {
+    let mut c = render(
+        scene,
+        out,
+        &["--width", "48", "--height", "36", "--backend", "cpu"],
+    );
+    succeeds(c.args(extra));
     image::open(out).unwrap().to_rgb8()
 }
 
@@ -1138,17 +868,12 @@ fn render_small_cpu(
 #[test]
 fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = root().join("scenes/fair_weather.toml");
-    let render = |name: &str, single: bool| {
-        let extra: &[&str] = if single {
-            &["--single-scattering"]
-        } else {
-            &[]
-        };
-        render_small_cpu(&scene, &dir.path().join(name), extra)
-    };
+    let scene = shipped("fair_weather.toml");
+    let render_as =
+        |name: &str, extra: &[&str]| render_small_cpu(&scene, &dir.path().join(name), extra);
     let black = |img: &image::RgbImage| img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
-    let (full, single) = (render("full.png", false), render("single.png", true));
+    let full = render_as("full.png", &[]);
+    let single = render_as("single.png", &["--single-scattering"]);
     assert_eq!(black(&full), 0, "the full picture has its sky");
     assert!(
         black(&single) > 200,
@@ -1162,23 +887,11 @@ fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
     );
 
     let out = dir.path().join("spheroids.png");
-    let o = cumulus(&[
-        "render",
-        "--light-photons",
-        "16",
-        "--scene",
-        root().join("scenes/spheroids.toml").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--backend",
-        "cpu",
-        "--single-scattering",
-    ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(
-        stderr(&o).contains("--single-scattering") && stderr(&o).contains("cloud_map"),
-        "{}",
-        stderr(&o)
+    let extra = ["--backend", "cpu", "--single-scattering"];
+    fails(
+        &mut render(shipped("spheroids.toml"), &out, &extra),
+        1,
+        &["--single-scattering", "cloud_map"],
     );
     assert!(!out.exists());
 }
@@ -1190,13 +903,12 @@ fn render_single_scattering_leaves_the_sky_out_and_refuses_other_renderers() {
 #[test]
 fn render_exposes_a_twilight_sky() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(root().join("scenes/fair_weather.toml")).unwrap();
+    let text = std::fs::read_to_string(shipped("fair_weather.toml")).unwrap();
     let twilight = text.replace("sun_elevation_deg = 28.0", "sun_elevation_deg = -6.0");
     assert_ne!(twilight, text, "the shipped scene's sun moved");
     let sky = |extra: &str, name: &str| {
-        let scene = dir.path().join(format!("{name}.toml"));
         let with = twilight.replacen("[render]\n", &format!("[render]\n{extra}"), 1);
-        std::fs::write(&scene, with).unwrap();
+        let scene = write(dir.path(), &format!("{name}.toml"), &with);
         let img = render_small_cpu(
             &scene,
             &dir.path().join(format!("{name}.png")),
@@ -1234,29 +946,15 @@ fn lavapipe_at_a_thousand_steps_is_warned_about() {
     let Some(ctx) = common::gpu() else { return };
     let dir = tempfile::tempdir().expect("dir");
     let out = dir.path().join("s.png");
-    let scene = root().join("scenes/fair_weather.toml");
+    let scene = shipped("fair_weather.toml");
     let run = |steps: &str| {
-        let o = cumulus(&[
-            "render",
-            "--light-photons",
-            "16",
-            "--scene",
-            scene.to_str().expect("utf-8"),
-            "--out",
-            out.to_str().expect("utf-8"),
-            "--backend",
-            "gpu",
-            "--width",
-            "8",
-            "--height",
-            "6",
-            "--frames",
-            "1",
-            "--steps",
-            steps,
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        stderr(&o).contains("on lavapipe, which ends a shader's loops after 65535 iterations")
+        let mut c = render(
+            &scene,
+            &out,
+            &["--backend", "gpu", "--frames", "1", "--steps", steps],
+        );
+        stderr(&succeeds(c.args(["--width", "8", "--height", "6"])))
+            .contains("on lavapipe, which ends a shader's loops after 65535 iterations")
     };
     assert_eq!(run("1024"), ctx.is_llvmpipe());
     assert!(!run("512"));

@@ -2,7 +2,7 @@
 //! entraining-plume integration (tests/reference/entraining_plume.py, made
 //! once with MetPy 1.7.1's constants and committed): one parcel of the
 //! scene, undiluted and at the scene's entrainment rates, rises to the
-//! reference's apex within 300 m.
+//! reference's apex: within 15 m undiluted, 300 m entraining.
 
 use std::path::PathBuf;
 
@@ -10,8 +10,18 @@ use cumulus::scene::Scene;
 use cumulus::sim::Simulation;
 use glam::DVec3;
 
-/// The tolerance on the cloud top, m.
-const TOP_TOLERANCE_M: f64 = 300.0;
+/// Tolerance on the undiluted parcel's apex against the plume's, m: five
+/// times the measured 3 m (13,558 m against 13,561 m; `cargo test
+/// --release --test deep_convection -- --nocapture`, this 2-core machine).
+const UNDILUTED_TOP_TOLERANCE_M: f64 = 15.0;
+/// Tolerance on an entraining parcel's apex against the plume's, m:
+/// measured 101-222 m off (the simulator entrains in sub-steps of its own
+/// drift, the plume continuously), the physics' goal of 300 m.
+const ENTRAINING_TOP_TOLERANCE_M: f64 = 300.0;
+/// How far the whole scene's highest parcel may lie outside the range of
+/// the entraining and the undiluted references' apexes, m (its radii are
+/// spread by the jitter, its parcels pushed by SPH and wind).
+const SCENE_TOP_MARGIN_M: f64 = 300.0;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -112,8 +122,13 @@ fn parcel_tops_match_the_entraining_plume_reference_within_300_m() {
             "{}: simulator apex {top:.0} m, reference {:.0} m (LNB {:.0} m)",
             c.name, c.apex_m, c.lnb_m
         );
+        let tolerance = if c.coefficient == 0.0 {
+            UNDILUTED_TOP_TOLERANCE_M
+        } else {
+            ENTRAINING_TOP_TOLERANCE_M
+        };
         assert!(
-            (top - c.apex_m).abs() <= TOP_TOLERANCE_M,
+            (top - c.apex_m).abs() <= tolerance,
             "{}: apex {top:.0} m against the plume's {:.0} m",
             c.name,
             c.apex_m
@@ -156,7 +171,7 @@ fn the_scene_grows_towers_between_entraining_and_undiluted_tops() {
     let undiluted = cases[0].apex_m;
     eprintln!("scene: highest parcel {top:.0} m, highest cloudy {cloudy_top:.0} m");
     assert!(
-        top > widest - TOP_TOLERANCE_M && top < undiluted + TOP_TOLERANCE_M,
+        top > widest - SCENE_TOP_MARGIN_M && top < undiluted + SCENE_TOP_MARGIN_M,
         "highest parcel {top:.0} m, expected {widest:.0}..{undiluted:.0} m"
     );
     assert!(

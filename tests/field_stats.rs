@@ -5,9 +5,14 @@
 
 use cumulus::report::field_stats::{Cloud, Mask, area_perimeter_fit, size_density, size_fit};
 
-/// Tolerance on D: the fit of pixelated outlines over 1.5-2 decades of
-/// area.
-const D_TOLERANCE: f64 = 0.05;
+/// Tolerance on the discs' D: the fit of pixelated circles over 1.5-2
+/// decades of area, measured 1.016 (`cargo test --release --test
+/// field_stats -- --nocapture`), three times that off 1.
+const DISC_D_TOLERANCE: f64 = 0.05;
+/// Tolerance on the Koch islands' D, whose outlines are exact on the
+/// pixel grid: measured 1.5000 to four decimals, so only the fit's
+/// rounding is allowed.
+const KOCH_D_TOLERANCE: f64 = 5e-4;
 
 fn blank(w: usize, h: usize) -> Mask {
     Mask::from_fn(w, h, 10.0, |_, _| false)
@@ -31,7 +36,7 @@ fn discs_have_dimension_one_and_fail_the_natural_range() {
     assert_eq!(clouds.len(), 7);
     let d = 2.0 * area_perimeter_fit(&clouds, 1).expect("fit").slope;
     eprintln!("discs: D = {d:.4}");
-    assert!((d - 1.0).abs() < D_TOLERANCE, "discs: D = {d}");
+    assert!((d - 1.0).abs() < DISC_D_TOLERANCE, "discs: D = {d}");
     // Real cloud fields: 1.30..=1.40 (Lovejoy 1982); a disc field is not one.
     assert!(!(1.30..=1.40).contains(&d));
 }
@@ -103,8 +108,8 @@ fn quadratic_koch_islands_have_dimension_one_and_a_half() {
         clouds.extend(c);
     }
     let d = 2.0 * area_perimeter_fit(&clouds, 1).expect("fit").slope;
-    eprintln!("Koch islands: D = {d:.4}");
-    assert!((d - 1.5).abs() < D_TOLERANCE, "Koch islands: D = {d}");
+    eprintln!("Koch islands: D = {d:.6}");
+    assert!((d - 1.5).abs() < KOCH_D_TOLERANCE, "Koch islands: D = {d}");
 }
 
 #[test]

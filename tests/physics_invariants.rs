@@ -94,8 +94,11 @@ fn total_water_is_conserved_without_mixing_through_condensation() {
     assert!(peak_qc > 1e-4, "it condensed: peak q_c {peak_qc}");
 }
 
-/// Tolerance on the buoyancy-oscillation period: the 1 %.
-const PERIOD_TOLERANCE: f64 = 0.01;
+/// Tolerance on the buoyancy-oscillation period, relative: 0.4 %, about
+/// five times the worst measured, 8.3e-4 at dt 10 s (8e-6 at 1 s, 2.2e-5
+/// with virtual mass; `cargo test --release --test physics_invariants --
+/// --nocapture`). The physics' goal, 1 %, is in docs/physics.md.
+const PERIOD_TOLERANCE: f64 = 4e-3;
 
 fn measured_period(sim: &mut Simulation, z_eq: f64, frames: usize) -> f64 {
     // Upward zero crossings of z - z_eq, linearly interpolated.
@@ -140,6 +143,10 @@ fn brunt_vaisala_period_within_one_percent() {
         let th_low = atm.at(z_eq - 10.0).theta_l;
         sim.set_parcel(0, DVec3::new(0.0, 0.0, z_eq - 10.0), th_eq - th_low, 0.0);
         let period = measured_period(&mut sim, z_eq, (6.0 * expected / dt) as usize);
+        eprintln!(
+            "dt {dt}: period off 2π/N by {:.2e}",
+            (period - expected).abs() / expected
+        );
         assert!(
             (period - expected).abs() / expected < PERIOD_TOLERANCE,
             "dt {dt}: period {period:.2} s, 2π/N = {expected:.2} s"
@@ -160,31 +167,62 @@ fn virtual_mass_lengthens_the_period_by_sqrt_one_plus_gamma() {
     let d = atm.at(z_eq).theta_l - atm.at(z_eq - 10.0).theta_l;
     sim.set_parcel(0, DVec3::new(0.0, 0.0, z_eq - 10.0), d, 0.0);
     let period = measured_period(&mut sim, z_eq, (6.0 * expected / 2.0) as usize);
+    eprintln!(
+        "virtual mass: period off by {:.2e}",
+        (period - expected).abs() / expected
+    );
     assert!(
         (period - expected).abs() / expected < PERIOD_TOLERANCE,
         "{period} vs {expected}"
     );
 }
 
-#[test]
-fn entrainment_relaxes_exactly_even_for_huge_steps() {
-    // ε|w|Δt ≫ 1: an explicit step would overshoot; the exact relaxation
-    // lands on the environment and never past it.
+/// One sub-step of a dry parcel entraining at `coefficient` (radius 10 m,
+/// no drag, no virtual mass) from 500 m at 5 m/s and 5 K warmer than its
+/// environment: (θ_l excess over the environment where it lands, the
+/// analytic excess `(θ_l0 - θ_l,env(z1)) exp(-ε |z1 - z0|)`, the
+/// relaxation factor). One sub-step of `dt_s`: the parcel drifts by
+/// `w Δt`, so `ε |w| Δt` is `ε |z1 - z0|`.
+fn entrain_once(coefficient: f64, dt_s: f64) -> (f64, f64, f64) {
     let atm = stable_dry_layer(6.5);
-    let mut cfg = bare_physics(600.0);
+    let mut cfg = bare_physics(dt_s);
     cfg.entrainment.enabled = true;
-    cfg.entrainment.coefficient = 2.0;
+    cfg.entrainment.coefficient = coefficient;
     cfg.radius_m = 10.0;
     cfg.radius_jitter = 0.0;
-    let mut sim = Simulation::with_positions(cfg, atm, &[DVec3::new(0.0, 0.0, 500.0)]);
-    sim.set_parcel(0, DVec3::new(0.0, 0.0, 500.0), 5.0, 0.0);
+    cfg.substeps.max_per_frame = 1;
+    let z0 = 500.0;
+    let mut sim = Simulation::with_positions(cfg, atm, &[DVec3::new(0.0, 0.0, z0)]);
+    sim.set_parcel(0, DVec3::new(0.0, 0.0, z0), 5.0, 0.0);
     sim.set_vertical_velocity(0, 5.0);
-    sim.step();
+    let theta_l0 = sim.parcels().theta_l[0];
+    let stats = sim.step();
+    assert_eq!(stats.substeps, 1);
     let p = sim.parcels();
-    let env = sim.atmosphere().at(p.pos[0].z);
-    let excess = p.theta_l[0] - env.theta_l;
+    let z1 = p.pos[0].z;
+    assert!(z1 > z0 && z1 < sim.atmosphere().top_m(), "{z1}");
+    let env = sim.atmosphere().at(z1);
+    let f = (-coefficient / 10.0 * (z1 - z0)).exp();
+    (p.theta_l[0] - env.theta_l, (theta_l0 - env.theta_l) * f, f)
+}
+
+#[test]
+fn entrainment_relaxes_exactly_even_for_huge_steps() {
+    // θ_l relaxes toward the environment by exactly exp(-ε|w|Δt): at a
+    // moderate ε|w|Δt, where an explicit step (1 - ε|w|Δt) or an implicit
+    // one (1 / (1 + ε|w|Δt)) is off by a tenth of the excess or more, and
+    // at ε|w|Δt ≫ 1, where the explicit step would overshoot past the
+    // environment and the implicit one keep 1 % of the excess.
+    let (excess, analytic, f) = entrain_once(0.02, 60.0);
+    assert!((0.1..0.9).contains(&f), "a moderate relaxation: {f}");
     assert!(
-        (0.0..5.0).contains(&excess),
-        "θ_l excess {excess} must shrink without changing sign"
+        (excess - analytic).abs() <= 1e-9 * analytic.abs().max(1.0),
+        "θ_l excess {excess}, analytic {analytic} (factor {f})"
+    );
+    let (excess, analytic, f) = entrain_once(2.0, 600.0);
+    assert!(f < 1e-6, "a huge relaxation: {f}");
+    assert!(
+        (excess - analytic).abs() <= 1e-9 && excess >= 0.0,
+        "θ_l excess {excess}, analytic {analytic} (factor {f})"
     );
 }

@@ -351,8 +351,10 @@ fn the_shadow_rays_offsets_average_to_the_exact_optical_depth() {
     assert!(centred_worst > 0.02, "centred steps off by {centred_worst}");
 }
 
-/// Beer-Lambert tolerance: 1 % (the issue's).
-const BEER_LAMBERT_TOLERANCE: f32 = 0.01;
+/// Beer-Lambert tolerance, relative: 2e-5, five times the measured 3.9e-6
+/// (f32 rounding of the march's products; `cargo test --release --test
+/// render_cpu constant_slab -- --nocapture`).
+const BEER_LAMBERT_TOLERANCE: f32 = 2e-5;
 
 #[test]
 fn constant_slab_transmittance_matches_beer_lambert() {
@@ -451,6 +453,10 @@ fn constant_slab_transmittance_matches_beer_lambert() {
     };
     let s = march_ray(origin, Vec3::Y, 0.5, 0.0, &frame);
     let expected = (-tau).exp() as f32;
+    eprintln!(
+        "slab transmittance off Beer-Lambert by {:.2e}",
+        (s.transmittance - expected).abs() / expected
+    );
     assert!(
         (s.transmittance - expected).abs() / expected < BEER_LAMBERT_TOLERANCE,
         "{} vs {expected}",
@@ -575,18 +581,64 @@ fn frame_is_finite_has_sky_and_cloud_and_is_deterministic() {
     assert_eq!(grey, 0, "no cloud pixels without coverage");
 }
 
+/// Pixel `(x, y)` of a `w x h` picture of `f` made the long way, from its
+/// definition rather than through `stills`: the mean of `frames` marches
+/// ([`march_ray`]) from the eye through the pixel's centre, shifted (when
+/// `jittered`) by frame `k`'s Halton (2, 3) sub-pixel offset, each with
+/// the pixel's blue-noise dither plus `k` golden-ratio steps.
+fn pixel_by_definition(
+    f: &Frame,
+    w: u32,
+    h: u32,
+    x: u32,
+    y: u32,
+    frames: u32,
+    jittered: bool,
+) -> Vec3 {
+    use cumulus::render::cpu::renderer::pixel_dither;
+    use cumulus::render::sampling::{GOLDEN, halton};
+    let spread = f.view.pixel_spread(w, h);
+    let mut sum = Vec3::ZERO;
+    for k in 0..frames {
+        let (jx, jy) = if jittered {
+            (halton(k + 1, 2) - 0.5, halton(k + 1, 3) - 0.5)
+        } else {
+            (0.0, 0.0)
+        };
+        let golden = k as f64 * GOLDEN as f64;
+        let dither = (pixel_dither(x, y) + (golden - golden.floor()) as f32).fract();
+        let dir = f
+            .view
+            .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, w, h);
+        sum += march_ray(f.view.eye(), dir, dither, spread, f).radiance;
+    }
+    sum / frames as f32
+}
+
+/// `img` (`w x h`, row-major) agrees with [`pixel_by_definition`] on a
+/// spread of its pixels, to float rounding.
+fn matches_definition(img: &[Vec3], f: &Frame, w: u32, h: u32, frames: u32, jittered: bool) {
+    for (x, y) in (0..24).map(|i| ((i * 37 + 5) % w, (i * 23 + 3) % h)) {
+        let want = pixel_by_definition(f, w, h, x, y, frames, jittered);
+        let got = img[(y * w + x) as usize];
+        assert!(
+            (got - want).abs().max_element() <= 1e-5 * want.abs().max_element().max(1e-3),
+            "pixel ({x}, {y}): {got} against {want} by definition ({frames} frames, jittered {jittered})"
+        );
+    }
+}
+
 /// A CPU still (`render_still`, what `cumulus render --backend cpu`
 /// writes) averages its `cpu_offsets` marches as the GPU's first TSAA
-/// frames, sub-pixel jitter included: it lands closer to a 4x4
+/// frames, sub-pixel jitter included (each pixel the mean of its marches
+/// by definition, [`pixel_by_definition`]): it lands closer to a 4x4
 /// box-filtered image of the same scene than the same four marches
 /// through the pixels' centres, whose cloud outlines and far ground
-/// shadows are staircases; one offset is still `render_linear`.
+/// shadows are staircases; one offset is one march through the centre.
 #[test]
 fn a_still_is_anti_aliased_like_the_gpus_frames() {
     use cumulus::prepare::Prepared;
-    use cumulus::render::cpu::stills::{
-        render_converged, render_linear_offsets, render_still, supersampled_srgb8,
-    };
+    use cumulus::render::cpu::stills::{render_linear_offsets, render_still, supersampled_srgb8};
     let mut sc = cumulus::scene::Scene::load(std::path::Path::new("scenes/fair_weather.toml"))
         .expect("shipped scene");
     sc.render.time_s = 1800.0;
@@ -605,8 +657,8 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
             / (255.0 * b.len() as f64)
     };
     let still = render_still(w, h, &f, 4);
-    assert_eq!(still, render_converged(w, h, &f, 4));
-    assert_eq!(render_still(w, h, &f, 1), render_linear(w, h, &f));
+    matches_definition(&still, &f, w, h, 4, true);
+    matches_definition(&render_still(w, h, &f, 1), &f, w, h, 1, false);
     let (e_still, e_centres) = (err(&still), err(&render_linear_offsets(w, h, &f, 4)));
     eprintln!("against 4x4 supersampling: still {e_still:.5}, centres {e_centres:.5}");
     assert!(
@@ -618,7 +670,8 @@ fn a_still_is_anti_aliased_like_the_gpus_frames() {
 /// Averaging the march over shifted sample offsets (the dither half of what
 /// `render.cpu_offsets` does for CPU pictures) takes the fixed dither's pattern out: at 16 steps,
 /// four offsets land at least a third closer to a 384-step image than one
-/// (measured 0.60 times as far), and one offset is `render_linear` exactly.
+/// (measured 0.60 times as far); both are the mean of their marches by
+/// definition ([`pixel_by_definition`]).
 /// 16 steps, because at 24 the dither's part of the error is small (the
 /// horizon's grazing rays take more steps), and the rest, clouds that
 /// fall between the coarse steps' fixed ends, is the same for every
@@ -650,8 +703,9 @@ fn averaged_offsets_approach_the_many_step_image() {
     };
     let f16 = frame(16);
     let one = render_linear_offsets(w, h, &f16, 1);
-    assert_eq!(one, render_linear(w, h, &f16));
+    matches_definition(&one, &f16, w, h, 1, false);
     let four = render_linear_offsets(w, h, &f16, 4);
+    matches_definition(&four, &f16, w, h, 4, false);
     let (e1, e4) = (err(&one), err(&four));
     eprintln!("16 steps: one offset {e1:.5}, four offsets {e4:.5} from 384 steps");
     assert!(e4 < 0.67 * e1, "one offset {e1}, four {e4}");

@@ -6,8 +6,11 @@ use cumulus::sim::config::PhysicsConfig;
 use cumulus::sim::{Atmosphere, ParametricProfile, Simulation};
 use glam::DVec3;
 
-/// Water budget closure, relative (the 1e-9).
-const BUDGET_TOLERANCE: f64 = 1e-9;
+/// Water budget closure, relative: 2e-15, about four times the worst
+/// measured over the matrix, 4.8e-16 (f64 round-off of compensated sums;
+/// `cargo test --release --test stability -- --nocapture`). The physics'
+/// goal, 1e-9, is in docs/physics.md.
+const BUDGET_TOLERANCE: f64 = 2e-15;
 
 const DTS: [f64; 6] = [1e-3, 0.1, 1.0, 10.0, 60.0, 600.0];
 const RHS: [f64; 4] = [0.0, 0.5, 1.0, 1.2];
@@ -89,6 +92,10 @@ fn check(sim: &Simulation, n: usize, what: &str) {
         );
     }
     let b = sim.water_budget();
+    eprintln!(
+        "{what}: water budget residual {:.1e}",
+        b.relative_residual()
+    );
     assert!(
         b.relative_residual() < BUDGET_TOLERANCE,
         "{what}: water budget {b:?}"
