@@ -788,20 +788,50 @@ fn shipped_scenes_work_outside_the_repository() {
             .current_dir(dir.path());
         c
     };
-    let built_in = ["using the built-in copy"];
-    succeeds_saying(&mut render_here("scenes/fair_weather.toml"), &built_in);
+    // A shipped scene by its bare name: the built-in copy, said so.
+    let built_in = ["the built-in copy of scenes/fair_weather.toml"];
+    succeeds_saying(&mut render_here("fair_weather"), &built_in);
     assert!(dir.path().join("sky.png").is_file());
-    // Not a shipped scene's name: the usual error.
+    // A path that names no file is an error, never the built-in copy in
+    // its place; for a shipped scene's file name it names the built-in.
+    for scene in ["scenes/fair_weather.toml", "/typo/fair_weather.toml"] {
+        fails(
+            &mut render_here(scene),
+            1,
+            &[scene, "no such file", "`--scene fair_weather`"],
+        );
+    }
     fails(
         &mut render_here("scenes/mine.toml"),
         1,
-        &["cannot read scene"],
+        &["scenes/mine.toml", "cannot read scene"],
     );
-    // `scene check` reads a scene as the other commands do (it said "No
-    // such file" for the name `render` takes).
-    let mut check = cumulus(&["scene", "check", "scenes/fair_weather.toml"]);
+    fails(
+        &mut render_here("mine"),
+        1,
+        &["`mine`", "built-in scenes: ", "fair_weather", "evening"],
+    );
+    // `scene check` reads a scene as the other commands do.
+    let mut check = cumulus(&["scene", "check", "fair_weather"]);
     let o = succeeds_saying(check.current_dir(dir.path()), &built_in);
     assert!(stdout(&o).contains(": ok ("));
+    let mut check = cumulus(&["scene", "check", "/some/missing/evening.toml"]);
+    let o = check.current_dir(dir.path()).output().unwrap();
+    assert_failed(
+        "scene check /some/missing/evening.toml",
+        &o,
+        1,
+        &["/some/missing/evening.toml", "no such file"],
+    );
+    assert!(!stdout(&o).contains("ok"), "{}", stdout(&o));
+    // simulate too: a typo in the path is not silently the built-in scene.
+    let out = dir.path().join("c.csv");
+    fails(
+        &mut simulate("/typo/fair_weather.toml", &out, &[]),
+        1,
+        &["/typo/fair_weather.toml", "no such file"],
+    );
+    assert!(!out.exists());
 }
 
 #[test]
@@ -958,4 +988,65 @@ fn lavapipe_at_a_thousand_steps_is_warned_about() {
     };
     assert_eq!(run("1024"), ctx.is_llvmpipe());
     assert!(!run("512"));
+}
+
+/// `--out` naming a file the run reads is refused before anything is
+/// written: the scene's sounding, a `--sounding`, the profile's sounding.
+#[test]
+fn an_output_that_is_an_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for f in ["bomex.toml", "bomex_sounding.csv"] {
+        std::fs::copy(root.join("scenes").join(f), dir.path().join(f)).unwrap();
+    }
+    let scene = dir.path().join("bomex.toml");
+    let sounding = dir.path().join("bomex_sounding.csv");
+    let before = std::fs::read(&sounding).unwrap();
+    fails(
+        &mut simulate(&scene, &sounding, &["--duration-s", "60"]),
+        1,
+        &[
+            "bomex_sounding.csv",
+            "is the scene's sounding this run reads",
+            "choose another --out",
+        ],
+    );
+    let other = write(
+        dir.path(),
+        "other.csv",
+        "height_m,pressure_hPa,temperature_C,dewpoint_C\n0,1000,20,15\n1000,,12,8\n3000,,0,-5\n",
+    );
+    fails(
+        &mut simulate(
+            shipped("fair_weather.toml"),
+            &other,
+            &["--sounding", path(&other)],
+        ),
+        1,
+        &["other.csv", "is the sounding this run reads"],
+    );
+    fails(
+        &mut cumulus(&[
+            "profile",
+            "--sounding",
+            path(&sounding),
+            "--out",
+            path(&sounding),
+        ]),
+        1,
+        &["is the sounding this run reads"],
+    );
+    // The same file by another name is the same file.
+    let dotted = dir.path().join(".").join("bomex_sounding.csv");
+    fails(
+        &mut simulate(&scene, &dotted, &["--duration-s", "60"]),
+        1,
+        &["is the scene's sounding this run reads"],
+    );
+    assert_eq!(
+        std::fs::read(&sounding).unwrap(),
+        before,
+        "the input is untouched"
+    );
+    assert!(std::fs::read(&other).unwrap().starts_with(b"height_m"));
 }

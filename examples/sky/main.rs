@@ -3,7 +3,7 @@
 //! controls, debug views and a frame-timing overlay.
 //!
 //! ```sh
-//! cargo run --release --example sky [-- --scene scenes/evening.toml]
+//! cargo run --release --example sky [-- --scene scenes/bomex.toml]
 //! cargo run --release --example sky -- --screenshot shot.png --frames 60
 //! ```
 //!
@@ -38,7 +38,8 @@ use crate::world::World;
 #[command(about = "Living cumulus over a landscape (cumulus sky demo)")]
 struct Args {
     /// Scene to start with.
-    #[arg(long, default_value = "scenes/evening.toml")]
+    /// (A TOML file, or the name of a built-in shipped scene.)
+    #[arg(long, default_value = "evening")]
     scene: PathBuf,
     /// Render --frames frames, save the last one to this PNG, and exit.
     #[arg(long)]

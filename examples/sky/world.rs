@@ -66,7 +66,7 @@ impl World {
         let (scene, builtin) = Scene::load_or_builtin(path)?;
         if builtin {
             eprintln!(
-                "{}: not found here; using the built-in copy (pass --scene PATH for another scene)",
+                "scene: the built-in copy of scenes/{}.toml (pass --scene PATH for a file)",
                 path.display()
             );
         }

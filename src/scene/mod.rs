@@ -50,6 +50,14 @@ pub enum SceneError {
     },
     #[error(transparent)]
     Sounding(#[from] SoundingError),
+    #[error(
+        "{path}: no such file; the built-in copy of this shipped scene is `--scene {name}` (a name, no path)"
+    )]
+    MissingShipped { path: PathBuf, name: String },
+    #[error(
+        "`{name}`: no scene file of that name here, and no built-in scene of it; built-in scenes: {known}"
+    )]
+    UnknownBuiltin { name: String, known: String },
 }
 
 /// A scene.
@@ -97,20 +105,46 @@ impl Scene {
             .map(|(n, text)| Self::parse(text, Path::new(&format!("(built-in) scenes/{n}"))))
     }
 
-    /// [`Self::load`], except that when there is no file at `path` and its
-    /// name is that of a built-in scene (a tool run outside the repository
-    /// with a default `scenes/NAME.toml`), the built-in copy; the flag says
-    /// which it was.
-    pub fn load_or_builtin(path: &Path) -> Result<(Self, bool), SceneError> {
-        if !path.exists()
-            && let Some(b) = path
-                .file_name()
-                .and_then(|n| n.to_str())
-                .and_then(Self::builtin)
-        {
-            return Ok((b?, true));
+    /// The scene a command line names: the file at `arg` when there is
+    /// one; else, when `arg` is a bare name (no folder, no extension, e.g.
+    /// `fair_weather`), the built-in copy of that shipped scene
+    /// ([`BUILTIN`]), so the tools run outside the repository. The flag
+    /// says which it was. A path that names no file is an error, never a
+    /// built-in copy in its place: it says so, and names the built-in
+    /// scene of the same name where there is one.
+    pub fn load_or_builtin(arg: &Path) -> Result<(Self, bool), SceneError> {
+        if arg.is_file() {
+            return Ok((Self::load(arg)?, false));
         }
-        Ok((Self::load(path)?, false))
+        let bare = arg.components().count() == 1 && arg.extension().is_none();
+        if bare && let Some(name) = arg.to_str() {
+            return match Self::builtin(&format!("{name}.toml")) {
+                Some(b) => Ok((b?, true)),
+                None => Err(SceneError::UnknownBuiltin {
+                    name: name.to_owned(),
+                    known: Self::builtin_names().join(", "),
+                }),
+            };
+        }
+        if !arg.exists()
+            && let Some(stem) = arg.file_stem().and_then(|s| s.to_str())
+            && arg.extension().is_some_and(|e| e == "toml")
+            && Self::builtin(&format!("{stem}.toml")).is_some()
+        {
+            return Err(SceneError::MissingShipped {
+                path: arg.to_owned(),
+                name: stem.to_owned(),
+            });
+        }
+        Ok((Self::load(arg)?, false))
+    }
+
+    /// The names of the built-in scenes, for `--scene NAME`.
+    pub fn builtin_names() -> Vec<&'static str> {
+        BUILTIN
+            .iter()
+            .map(|(n, _)| n.trim_end_matches(".toml"))
+            .collect()
     }
 
     /// Reads, parses and validates a scene file.

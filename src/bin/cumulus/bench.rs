@@ -9,8 +9,9 @@ use crate::{gpu_context, load_scene};
 #[derive(clap::Args)]
 #[command(after_help = "Example:\n  cumulus bench --quick --out bench/")]
 pub struct BenchArgs {
-    /// Scene every configuration starts from.
-    #[arg(long, default_value = "scenes/fair_weather.toml")]
+    /// Scene every configuration starts from: a TOML file, or the name
+    /// of a built-in shipped scene.
+    #[arg(long, default_value = "fair_weather")]
     scene: PathBuf,
     /// Output directory (bench.csv, bench.json, physics_in_frame.csv,
     /// render_error.csv and the plots).

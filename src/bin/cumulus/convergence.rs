@@ -13,7 +13,8 @@ use crate::{load_scene, progress_bar};
     after_help = "Example:\n  cumulus convergence --scene scenes/bomex.toml --out convergence/"
 )]
 pub struct ConvergenceArgs {
-    /// Scene TOML file.
+    /// Scene TOML file, or the name of a built-in shipped scene
+    /// (fair_weather, evening, strong_inversion, ...: `--scene fair_weather`).
     #[arg(long)]
     scene: PathBuf,
     /// Simulated time per run, seconds (at least 600: the runs are compared

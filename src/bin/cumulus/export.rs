@@ -22,7 +22,8 @@ use crate::{
     after_help = "Example:\n  cumulus export --scene scenes/fair_weather.toml --out clouds.vol --sky sky.exr\n  cumulus export --scene scenes/bomex.toml --out bomex.vol --cells 512 --box 0,500,0,4000,2500,4000\n  cumulus export --scene scenes/fair_weather.toml --out clouds.vdb --cells 512"
 )]
 pub struct ExportArgs {
-    /// Scene TOML file.
+    /// Scene TOML file, or the name of a built-in shipped scene
+    /// (fair_weather, evening, strong_inversion, ...: `--scene fair_weather`).
     #[arg(long)]
     scene: PathBuf,
     /// Output volume of the extinction per metre: .vol (a Mitsuba 3 grid
@@ -92,6 +93,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
             s.render.time_s = t;
         }
     })?;
+    let inputs = crate::scene_inputs(&scene, None);
+    crate::refuse_overwriting_inputs(&a.out, &inputs)?;
+    crate::refuse_overwriting_inputs(&sidecar_path, &inputs)?;
     // The grid is checked before the simulation: the default box is the
     // domain across the band, both known from the scene alone.
     let r = &scene.render;

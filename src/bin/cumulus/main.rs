@@ -79,7 +79,7 @@ enum SceneCommand {
     /// Validate a scene (and its sounding); report errors with file, line and key.
     #[command(after_help = "Example:\n  cumulus scene check scenes/bomex.toml")]
     Check {
-        /// Scene TOML file.
+        /// Scene TOML file, or the name of a built-in shipped scene.
         file: PathBuf,
     },
 }
@@ -106,8 +106,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene {
             command: SceneCommand::Check { file },
         } => {
-            // As every other command reads it: outside the repository a
-            // shipped scene's name checks its built-in copy, said so.
+            // As every other command reads it: a file, or a shipped
+            // scene's built-in copy by its bare name, said so.
             let scene = load_scene(&file)?;
             let atm = scene.atmosphere(None)?;
             let band = scene.band(&atm);
@@ -191,13 +191,13 @@ fn finite_positive(name: &str, v: f64) -> Result<()> {
     Ok(())
 }
 
-/// The scene at `path` ([`Scene::load_or_builtin`]: outside the
-/// repository a shipped scene's built-in copy, said so).
+/// The scene `path` names ([`Scene::load_or_builtin`]: a file, or a
+/// shipped scene's built-in copy by its bare name, said so).
 fn load_scene(path: &Path) -> Result<Scene> {
     let (scene, builtin) = Scene::load_or_builtin(path)?;
     if builtin {
         eprintln!(
-            "{}: not found here; using the built-in copy (pass --scene PATH for another scene)",
+            "scene: the built-in copy of scenes/{}.toml (pass --scene PATH for a file)",
             path.display()
         );
     }
@@ -305,6 +305,43 @@ fn write_exr(out: &Path, width: u32, height: u32, rgb: Vec<f32>) -> Result<()> {
     let img = image::Rgb32FImage::from_raw(width, height, rgb).context("image buffer size")?;
     cumulus::io::write_exr_atomically(out, &img)
         .with_context(|| format!("{}: cannot write image", out.display()))
+}
+
+/// Refuses an output `out` that is one of the files the run reads: the
+/// scene file, its sounding, a `--sounding` given on the command line
+/// (`inputs`, those that exist). Without it the run's atomic write would
+/// replace its own input.
+fn refuse_overwriting_inputs(out: &Path, inputs: &[(&str, PathBuf)]) -> Result<()> {
+    let Ok(target) = std::fs::canonicalize(out) else {
+        // No file there yet: it is none of the inputs, which exist.
+        return Ok(());
+    };
+    for (what, input) in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|i| i == target) {
+            bail!(
+                "{}: is the {what} this run reads ({}); choose another --out",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The files a run of `scene` reads: the scene file (none for a built-in
+/// scene), its sounding, and the `--sounding` override.
+fn scene_inputs(scene: &Scene, sounding: Option<&Path>) -> Vec<(&'static str, PathBuf)> {
+    let mut v = Vec::new();
+    if let Some(p) = &scene.source {
+        v.push(("scene", p.clone()));
+    }
+    if let Some(p) = scene.atmosphere.sounding_path(scene.source.as_deref()) {
+        v.push(("scene's sounding", p));
+    }
+    if let Some(p) = sounding {
+        v.push(("sounding", p.to_owned()));
+    }
+    v
 }
 
 /// Fails early, before any simulation, when `path` cannot be written: it is

@@ -74,6 +74,7 @@ pub fn run(a: ProfileArgs) -> Result<()> {
         }
     }
     if let Some(out) = &a.out {
+        crate::refuse_overwriting_inputs(out, &[("sounding", a.sounding.clone())])?;
         crate::guard_output_file(out);
         write_atomically(out, |w| {
             writeln!(

@@ -22,7 +22,8 @@ use crate::{
     after_help = "Example:\n  cumulus render --scene scenes/fair_weather.toml --out sky.png\n  cumulus render --scene scenes/evening.toml --backend gpu --time-frames 100 --out evening.png"
 )]
 pub struct RenderArgs {
-    /// Scene TOML file.
+    /// Scene TOML file, or the name of a built-in shipped scene
+    /// (fair_weather, evening, strong_inversion, ...: `--scene fair_weather`).
     #[arg(long)]
     scene: PathBuf,
     /// Output picture, written atomically: .png (tone-mapped with ACES
@@ -128,6 +129,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut picture = None;
     if let Some(out) = &a.out {
         check_output_file(out)?;
+        crate::refuse_overwriting_inputs(out, &crate::scene_inputs(&scene, None))?;
         picture = Some(Picture::of(out)?);
         guard_output_file(out);
     }

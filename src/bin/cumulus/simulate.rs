@@ -15,7 +15,8 @@ use crate::{finite_positive, guard_output_file, load_scene, progress_bar, with_o
     after_help = "Example:\n  cumulus simulate --scene scenes/bomex.toml --duration-s 3600 --out curves.csv"
 )]
 pub struct SimulateArgs {
-    /// Scene TOML file.
+    /// Scene TOML file, or the name of a built-in shipped scene
+    /// (fair_weather, evening, strong_inversion, ...: `--scene fair_weather`).
     #[arg(long)]
     scene: PathBuf,
     /// Sounding CSV replacing the scene's atmosphere (header
@@ -68,6 +69,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     finite_positive("--duration-s", a.duration_s)?;
     let every = a.every_s.unwrap_or(scene.physics.dt_s);
     finite_positive("--every-s", every)?;
+    crate::refuse_overwriting_inputs(&a.out, &crate::scene_inputs(&scene, a.sounding.as_deref()))?;
     let atm = scene.atmosphere(a.sounding.as_deref())?;
     guard_output_file(&a.out);
     let band = scene.band(&atm);

@@ -14,7 +14,8 @@ use crate::{load_scene, progress_bar, with_overrides};
 #[derive(clap::Args)]
 #[command(after_help = "Example:\n  cumulus stats --scene scenes/bomex.toml --out stats/")]
 pub struct StatsArgs {
-    /// Scene TOML file.
+    /// Scene TOML file, or the name of a built-in shipped scene
+    /// (fair_weather, evening, strong_inversion, ...: `--scene fair_weather`).
     #[arg(long)]
     scene: PathBuf,
     /// Output directory (clouds.csv, size_density.csv,
