@@ -1050,3 +1050,28 @@ fn an_output_that_is_an_input_is_refused() {
     );
     assert!(std::fs::read(&other).unwrap().starts_with(b"height_m"));
 }
+
+/// A huge or tiny value is reported as written, `1e308`, not as its 309
+/// digits.
+#[test]
+fn huge_values_are_reported_in_scientific_notation() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(dir.path(), "big.toml", "[physics]\nradius_m = 1e308\n");
+    let err = fails(
+        &mut cumulus(&["scene", "check", path(&scene)]),
+        1,
+        &["`physics.radius_m`: is 1e308, expected"],
+    );
+    assert!(err.len() < 300, "{err}");
+    let out = dir.path().join("c.csv");
+    let err = fails(
+        &mut simulate(
+            shipped("fair_weather.toml"),
+            &out,
+            &["--duration-s", "1e308"],
+        ),
+        1,
+        &["--duration-s is 1e308, expected"],
+    );
+    assert!(err.len() < 300, "{err}");
+}

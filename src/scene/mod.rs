@@ -355,7 +355,7 @@ impl Scene {
                 "physics.release_height_m",
                 format!(
                     "is {}, expected below the atmosphere's top at {top} m ({atm_top})",
-                    self.physics.release_height_m
+                    crate::sim::check::number(self.physics.release_height_m)
                 ),
             ));
         }

@@ -28,7 +28,7 @@ impl Check {
             key: key.into(),
             ok,
             expected: expected.into(),
-            value: shortest(value),
+            value: number(value),
         }
     }
 
@@ -52,15 +52,19 @@ impl Check {
     }
 }
 
-/// `value` as the user wrote it: a value read into an `f32` field and
-/// widened (every f32 is an f64) printed as the f32 it is, `-89.9` and
-/// not `-89.9000015258789`; any other as the f64.
-fn shortest(value: f64) -> String {
+/// `value` as the user wrote it, for a message: a value read into an
+/// `f32` field and widened (every f32 is an f64) printed as the f32 it
+/// is, `-89.9` and not `-89.9000015258789`; any other as the f64; in
+/// scientific notation (`1e308`) from 1e15 up or below 1e-5, where the
+/// plain form runs to hundreds of digits.
+pub fn number(value: f64) -> String {
     let narrow = value as f32;
-    if f64::from(narrow) == value {
-        narrow.to_string()
-    } else {
-        value.to_string()
+    let scientific = value.is_finite() && value != 0.0 && !(1e-5..1e15).contains(&value.abs());
+    match (f64::from(narrow) == value, scientific) {
+        (true, false) => narrow.to_string(),
+        (true, true) => format!("{narrow:e}"),
+        (false, false) => value.to_string(),
+        (false, true) => format!("{value:e}"),
     }
 }
 
@@ -105,6 +109,9 @@ mod tests {
         assert_eq!(Check::new("k", true, "", 0.1).value, "0.1");
         assert_eq!(Check::new("k", true, "", 12.0).value, "12");
         assert_eq!(Check::new("k", true, "", f64::NAN).value, "NaN");
-        assert_eq!(Check::new("k", true, "", 1e300).value, 1e300.to_string());
+        assert_eq!(Check::new("k", true, "", 1e300).value, "1e300");
+        assert_eq!(Check::new("k", true, "", -1e308).value, "-1e308");
+        assert_eq!(Check::new("k", true, "", 2.5e-9).value, "2.5e-9");
+        assert_eq!(Check::new("k", true, "", 123456.0).value, "123456");
     }
 }

@@ -186,7 +186,10 @@ const MAX_DURATION_S: f64 = 1e7;
 
 fn finite_positive(name: &str, v: f64) -> Result<()> {
     if !(v.is_finite() && v > 0.0 && v <= MAX_DURATION_S) {
-        bail!("{name} is {v}, expected a positive number of seconds, at most {MAX_DURATION_S:e}");
+        bail!(
+            "{name} is {}, expected a positive number of seconds, at most {MAX_DURATION_S:e}",
+            cumulus::sim::check::number(v)
+        );
     }
     Ok(())
 }
