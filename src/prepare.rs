@@ -219,7 +219,19 @@ impl Prepared {
     /// before a frame with another sun, camera altitude or density
     /// settings.
     pub fn frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
-        self.frame_with(r, quality, true)
+        self.frame_with(r, quality, true, &|_| {})
+    }
+
+    /// [`Self::frame`], calling `progress` with the share of the light
+    /// volume's build done (0 to 1) while it is built; not at all when it
+    /// is not built (no light volume, or built already).
+    pub fn frame_reporting<'a>(
+        &'a self,
+        r: &RenderSettings,
+        quality: Quality,
+        progress: &dyn Fn(f32),
+    ) -> Frame<'a> {
+        self.frame_with(r, quality, true, progress)
     }
 
     /// [`Self::frame`] without the light volume, for what reads only the
@@ -227,10 +239,16 @@ impl Prepared {
     /// volumes) or lights itself (the spheroid and volume renderers'
     /// CPU twins): nothing is built for the light.
     pub fn density_frame<'a>(&'a self, r: &RenderSettings, quality: Quality) -> Frame<'a> {
-        self.frame_with(r, quality, false)
+        self.frame_with(r, quality, false, &|_| {})
     }
 
-    fn frame_with<'a>(&'a self, r: &RenderSettings, quality: Quality, lit: bool) -> Frame<'a> {
+    fn frame_with<'a>(
+        &'a self,
+        r: &RenderSettings,
+        quality: Quality,
+        lit: bool,
+        progress: &dyn Fn(f32),
+    ) -> Frame<'a> {
         let sky = quality.atmosphere.sky_params().and_then(|params| {
             self.sky
                 .get_or_init(|| {
@@ -249,7 +267,13 @@ impl Prepared {
                 .then(|| {
                     self.light.get_or_init(|| {
                         let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
-                        LightVolume::build(&fields, &density, sun, quality.light_photons)
+                        LightVolume::build_reporting(
+                            &fields,
+                            &density,
+                            sun,
+                            quality.light_photons,
+                            progress,
+                        )
                     })
                 });
         Frame {

@@ -329,6 +329,21 @@ fn off_a_terminal_a_run_reports_progress_in_plain_lines() {
         &mut simulate(shipped("fair_weather.toml"), &csv, &extra),
         &["simulating: 50 % (60 of 120)", "simulating: 100 %"],
     );
+    // A CPU still reports each long phase, then each phase's time.
+    let png = dir.path().join("sky.png");
+    let extra = ["--backend", "cpu", "--width", "32", "--height", "24"];
+    succeeds_saying(
+        &mut render(shipped("fair_weather.toml"), &png, &extra),
+        &[
+            "simulating: 100 %",
+            "light volume: 50 %",
+            "light volume: 100 %",
+            "rendering: 50 %",
+            "rendering: 100 %",
+            " s simulating and ",
+            " s for the light volume",
+        ],
+    );
 }
 
 #[test]

@@ -153,6 +153,16 @@ impl Progress {
         }
     }
 
+    /// Moves on to `share` (0 to 1) of the work, for a bar of 100 units
+    /// fed with shares (never back).
+    pub fn to_share(&self, share: f32) {
+        let target = (share.clamp(0.0, 1.0) * 100.0).round() as u64;
+        let now = self.bar.position();
+        if target > now {
+            self.inc(target - now);
+        }
+    }
+
     /// Clears the bar (the plain lines stay).
     pub fn finish_and_clear(&self) {
         self.bar.finish_and_clear();

@@ -138,9 +138,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if scene.simulation.method == Method::Endless {
         return render_endless(gpu.as_ref(), &a, &scene, picture);
     }
+    let simulated = std::time::Instant::now();
     let bar = progress_bar(Prepared::frames(&scene), "simulating");
     let prepared = Prepared::from_scene(&scene, || bar.inc(1))?;
     bar.finish_and_clear();
+    let simulate_s = simulated.elapsed().as_secs_f64();
     let quality = Quality {
         single_scattering: a.single_scattering,
         ..r.quality()
@@ -148,7 +150,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(dir) = &a.quality_report {
         // The CPU's frame, its light volume built once here (the GPU
         // builds its own: a GPU picture does not wait for the CPU's).
-        quality_report(&prepared.frame(r, quality), r, dir)?;
+        quality_report(&lit_frame(&prepared, r, quality), r, dir)?;
     }
     if r.renderer == RenderMethod::Spheroids {
         return render_spheroids(gpu.as_ref(), &a, &scene, &prepared, picture);
@@ -157,7 +159,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         return render_gpu(ctx, &a, &scene, &prepared, picture);
     }
     match &a.out {
-        Some(out) => render_cpu(&a, &scene, &prepared, quality, out, picture),
+        Some(out) => render_cpu(&a, &scene, &prepared, quality, out, picture, simulate_s),
         None => Ok(()),
     }
 }
@@ -300,7 +302,22 @@ fn quality_report(frame: &Frame, r: &RenderSettings, dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The CPU's frame of `prepared` with its light volume, built with a
+/// progress bar (nothing shown when there is none to build).
+fn lit_frame<'a>(prepared: &'a Prepared, r: &RenderSettings, quality: Quality) -> Frame<'a> {
+    let bar = std::cell::OnceCell::new();
+    let frame = prepared.frame_reporting(r, quality, &|share| {
+        bar.get_or_init(|| progress_bar(100, "light volume"))
+            .to_share(share)
+    });
+    if let Some(b) = bar.get() {
+        b.finish_and_clear();
+    }
+    frame
+}
+
 /// The CPU reference's still of the cloud map's clouds, written to `out`.
+#[allow(clippy::too_many_arguments)]
 fn render_cpu(
     a: &RenderArgs,
     scene: &Scene,
@@ -308,14 +325,19 @@ fn render_cpu(
     quality: Quality,
     out: &Path,
     picture: Option<Picture>,
+    simulate_s: f64,
 ) -> Result<()> {
-    use cumulus::render::cpu::stills::{add_sun_glare, render_still};
+    use cumulus::render::cpu::stills::{add_sun_glare, render_still_reporting};
     let r = &scene.render;
     let built = std::time::Instant::now();
-    let frame = prepared.frame(r, quality);
+    let frame = lit_frame(prepared, r, quality);
     let light_s = built.elapsed().as_secs_f64();
     let start = std::time::Instant::now();
-    let mut linear = render_still(r.width, r.height, &frame, r.cpu_offsets);
+    let bar = progress_bar(100, "rendering");
+    let mut linear = render_still_reporting(r.width, r.height, &frame, r.cpu_offsets, &|share| {
+        bar.to_share(share)
+    });
+    bar.finish_and_clear();
     if picture != Some(Picture::Exr) {
         // The tone-mapped picture gets the sun's glare (`still_srgb8`; the
         // GPU's composite adds it the same way); the linear OpenEXR does
@@ -326,7 +348,7 @@ fn render_cpu(
 
     write_linear(out, picture, r, &linear)?;
     eprintln!(
-        "rendered {}x{} in {:.2} s after {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        "rendered {}x{} in {:.2} s after {simulate_s:.2} s simulating and {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
         r.height,
         elapsed.as_secs_f64(),

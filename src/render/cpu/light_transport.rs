@@ -143,14 +143,28 @@ pub fn trace(
     photons: u32,
     seed: u32,
 ) -> Vec<[f32; 9]> {
+    trace_reporting(grid, sigma, sun_dir, photons, seed, &|_| {})
+}
+
+/// [`trace`], calling `progress` with the share of the photons traced so
+/// far (0 to 1) after each batch, on the calling thread.
+pub fn trace_reporting(
+    grid: &LightVolumeGrid,
+    sigma: &[f32],
+    sun_dir: Vec3,
+    photons: u32,
+    seed: u32,
+    progress: &dyn Fn(f32),
+) -> Vec<[f32; 9]> {
     let n = grid.len();
     if sun_dir.y < LIGHT_SUN_MIN || photons == 0 {
         return vec![[0.0; 9]; n];
     }
-    let (_, sh) = run(grid, sigma, photons, seed, true, &|rng: &mut Rng| {
+    let start = |rng: &mut Rng| {
         let (pos, dir) = sun_photon(grid, sun_dir, rng);
         (pos, dir, Vec3::ONE)
-    });
+    };
+    let (_, sh) = run(grid, sigma, photons, seed, true, &start, progress);
     let scale = transport_scale(grid, sun_dir, photons);
     sh.iter().map(|c| c.map(|v| v * scale)).collect()
 }
@@ -182,20 +196,28 @@ pub fn trace_sky(
     seed: u32,
 ) -> (Vec<Vec3>, Vec<[f32; 9]>) {
     let cells = grid.cells.as_vec3();
-    let (length, sh) = run(grid, sigma, photons, seed, false, &|rng: &mut Rng| {
-        // Cosine-weighted about the inward normal.
-        let r = rng.next().sqrt();
-        let phi = 2.0 * PI * rng.next();
-        let up = (1.0 - r * r).max(0.0).sqrt();
-        let inward = Vec3::new(
-            r * phi.cos(),
-            if from_top { -up } else { up },
-            r * phi.sin(),
-        );
-        let y = if from_top { cells.y - 1e-4 } else { 1e-4 };
-        let pos = Vec3::new(rng.next() * cells.x, y, rng.next() * cells.z);
-        (pos, inward, radiance(-inward) * PI)
-    });
+    let (length, sh) = run(
+        grid,
+        sigma,
+        photons,
+        seed,
+        false,
+        &|rng: &mut Rng| {
+            // Cosine-weighted about the inward normal.
+            let r = rng.next().sqrt();
+            let phi = 2.0 * PI * rng.next();
+            let up = (1.0 - r * r).max(0.0).sqrt();
+            let inward = Vec3::new(
+                r * phi.cos(),
+                if from_top { -up } else { up },
+                r * phi.sin(),
+            );
+            let y = if from_top { cells.y - 1e-4 } else { 1e-4 };
+            let pos = Vec3::new(rng.next() * cells.x, y, rng.next() * cells.z);
+            (pos, inward, radiance(-inward) * PI)
+        },
+        &|_| {},
+    );
     let scale = area(grid) / photons.max(1) as f32 / volume(grid);
     (
         length.iter().map(|l| *l * scale).collect(),
@@ -218,6 +240,7 @@ fn run(
     seed: u32,
     scattered_only: bool,
     start: &Start,
+    progress: &dyn Fn(f32),
 ) -> (Vec<Vec3>, Vec<[f32; 9]>) {
     let n = grid.len();
     let colours = if scattered_only { 0 } else { n };
@@ -253,6 +276,7 @@ fn run(
                 }
             }
         }
+        progress((batch + at_once).min(chunks) as f32 / chunks as f32);
     }
     (length, sh)
 }

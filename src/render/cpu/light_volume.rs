@@ -30,7 +30,7 @@ use glam::{Vec3, Vec4};
 
 use super::density::{DensityParams, Fields, noise_point, warped_lookup};
 use super::light_grid::{LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons, read_cells};
-use super::light_transport::{PHASE_MOMENTS, SH_BAND, trace};
+use super::light_transport::{PHASE_MOMENTS, SH_BAND, trace, trace_reporting};
 use super::lighting::sh9;
 
 /// The cloud pass's three planes from the radiance coefficients `sh` (per
@@ -53,6 +53,10 @@ pub fn sh_planes(sh: &[[f32; 9]]) -> [Vec<Vec4>; 3] {
     ]
 }
 
+/// The share of a build's progress given to the cells' extinction (the
+/// rest is the photons'): about its share of the time on fair weather.
+const EXTINCTION_SHARE: f32 = 0.05;
+
 /// The sunlight scattered at least once over the clouds, per unit sun
 /// irradiance.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,9 +75,29 @@ impl LightVolume {
     /// `sun_dir`: [`cell_extinction`], then `per_column` photons for each
     /// column of cells ([`light_photons`], [`LIGHT_SEED`]).
     pub fn build(f: &Fields, d: &DensityParams, sun_dir: Vec3, per_column: u32) -> Self {
+        Self::build_reporting(f, d, sun_dir, per_column, &|_| {})
+    }
+
+    /// [`Self::build`], calling `progress` with the share of the build
+    /// done (0 to 1: the cells' extinction, then the photons by batch) on
+    /// the calling thread.
+    pub fn build_reporting(
+        f: &Fields,
+        d: &DensityParams,
+        sun_dir: Vec3,
+        per_column: u32,
+        progress: &dyn Fn(f32),
+    ) -> Self {
         let grid = LightVolumeGrid::new(d);
         let sigma = cell_extinction(&grid, f, d);
-        Self::trace(grid, &sigma, sun_dir, light_photons(&grid, per_column))
+        progress(EXTINCTION_SHARE);
+        let photons = light_photons(&grid, per_column);
+        let sh = trace_reporting(&grid, &sigma, sun_dir, photons, LIGHT_SEED, &|t| {
+            progress(EXTINCTION_SHARE + (1.0 - EXTINCTION_SHARE) * t)
+        });
+        progress(1.0);
+        let planes = sh_planes(&sh);
+        Self { grid, sh, planes }
     }
 
     /// The volume for the cells' extinction `sigma`, from `photons`.

@@ -51,11 +51,30 @@ pub fn render_converged(width: u32, height: u32, fr: &Frame, frames: u32) -> Vec
 /// shadows and the clouds' outlines against the sky are staircases);
 /// with 1, one march through each pixel's centre ([`render_linear`]).
 pub fn render_still(width: u32, height: u32, fr: &Frame, offsets: u32) -> Vec<Vec3> {
-    if offsets <= 1 {
-        render_linear(width, height, fr)
-    } else {
-        render_converged(width, height, fr, offsets)
-    }
+    render_still_reporting(width, height, fr, offsets, &|_| {})
+}
+
+/// [`render_still`], calling `progress` with the share of the rows done
+/// (0 to 1) after each band of rows, on the calling thread.
+pub fn render_still_reporting(
+    width: u32,
+    height: u32,
+    fr: &Frame,
+    offsets: u32,
+    progress: &dyn Fn(f32),
+) -> Vec<Vec3> {
+    render_marches_reporting(
+        width,
+        height,
+        fr,
+        offsets.max(1),
+        offsets > 1,
+        progress,
+        |s| s.radiance.extend(0.0),
+    )
+    .into_iter()
+    .map(Vec4::truncate)
+    .collect()
 }
 
 /// Per pixel (rayon over rows, row-major) the mean over `frames` marches
@@ -69,23 +88,46 @@ fn render_marches(
     jittered: bool,
     pick: impl Fn(RaySample) -> Vec4 + Sync,
 ) -> Vec<Vec4> {
+    render_marches_reporting(width, height, fr, frames, jittered, &|_| {}, pick)
+}
+
+/// Bands of rows a picture's progress is reported in.
+const PROGRESS_BANDS: usize = 50;
+
+/// [`render_marches`], in bands of rows (each band's rows in parallel),
+/// `progress` called with the share of the rows done after each band.
+fn render_marches_reporting(
+    width: u32,
+    height: u32,
+    fr: &Frame,
+    frames: u32,
+    jittered: bool,
+    progress: &dyn Fn(f32),
+    pick: impl Fn(RaySample) -> Vec4 + Sync,
+) -> Vec<Vec4> {
     let w = width as usize;
+    let h = height as usize;
     let spread = fr.view.pixel_spread(width, height);
-    let mut out = vec![Vec4::ZERO; w * height as usize];
-    out.par_chunks_mut(w.max(1))
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, px) in row.iter_mut().enumerate() {
-                let at = PixelMarches {
-                    x: x as u32,
-                    y: y as u32,
-                    width,
-                    height,
-                    spread,
-                };
-                *px = pixel_marches(at, fr, frames, jittered, &pick);
-            }
-        });
+    let mut out = vec![Vec4::ZERO; w * h];
+    let band_rows = h.div_ceil(PROGRESS_BANDS).max(1);
+    for (b, band) in out.chunks_mut((w * band_rows).max(1)).enumerate() {
+        band.par_chunks_mut(w.max(1))
+            .enumerate()
+            .for_each(|(r, row)| {
+                let y = b * band_rows + r;
+                for (x, px) in row.iter_mut().enumerate() {
+                    let at = PixelMarches {
+                        x: x as u32,
+                        y: y as u32,
+                        width,
+                        height,
+                        spread,
+                    };
+                    *px = pixel_marches(at, fr, frames, jittered, &pick);
+                }
+            });
+        progress(((b + 1) * band_rows).min(h) as f32 / h.max(1) as f32);
+    }
     out
 }
 
