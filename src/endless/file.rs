@@ -106,7 +106,9 @@ impl Database {
             path: path.to_owned(),
             what: what.to_owned(),
         };
-        let mut r = std::io::BufReader::new(std::fs::File::open(path).map_err(io)?);
+        let file = std::fs::File::open(path).map_err(io)?;
+        let size = file.metadata().map_err(io)?.len();
+        let mut r = std::io::BufReader::new(file);
         let mut first = String::new();
         r.read_line(&mut first).map_err(io)?;
         let mut words = first.split_whitespace();
@@ -124,9 +126,22 @@ impl Database {
         r.read_line(&mut line).map_err(io)?;
         let h: Header =
             serde_json::from_str(&line).map_err(|e| bad(&format!("header line 2: {e}")))?;
-        let voxels = h.dims.iter().product::<usize>();
-        if voxels == 0 || h.count == 0 || voxels.saturating_mul(h.count) > 1 << 31 {
-            return Err(bad("header line 2: empty or oversized volumes"));
+        let voxels = h.dims.iter().try_fold(1_usize, |n, &d| n.checked_mul(d));
+        let voxels = match voxels {
+            Some(v) if v > 0 && h.count > 0 && v.saturating_mul(h.count) <= 1 << 31 => v,
+            _ => return Err(bad("header line 2: empty or oversized volumes")),
+        };
+        // What the header promises, against what the file holds, before
+        // anything is allocated for it: a count of 2^31 asked for 48 GiB
+        // of volume list (and 2^65 bytes of distances), and the
+        // allocation's failure aborted the program.
+        let body = (h.count as u64)
+            .checked_mul(h.count as u64)
+            .and_then(|d| d.checked_mul(8))
+            .and_then(|d| d.checked_add(voxels as u64 * h.count as u64));
+        let rest = size.saturating_sub((first.len() + line.len()) as u64);
+        if body.is_none_or(|b| b > rest) {
+            return Err(bad("shorter than its header says"));
         }
         let mut volumes = Vec::with_capacity(h.count);
         for _ in 0..h.count {

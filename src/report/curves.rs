@@ -5,7 +5,11 @@ use std::io::Write;
 
 use crate::sim::{Band, Simulation};
 
-/// The CSV header (units in the names).
+/// The CSV header (units in the names). Positions are the physics'
+/// axes: `x_m`, `y_m` horizontal, `z_m` the height (z up, where the
+/// renderer and the volume export put y up). `age_s` counts from the
+/// parcel's release: negative while it waits at the ground
+/// (`physics.release_stagger_s` spreads the releases).
 pub const HEADER: [&str; 19] = [
     "t_s",
     "id",

@@ -116,7 +116,7 @@ impl EndlessConfig {
             Check::new(
                 "simulation.endless.cells",
                 [x, y, z].iter().all(|n| (2..=512).contains(n))
-                    && y as usize * self.volumes <= 2048,
+                    && (y as usize).saturating_mul(self.volumes) <= 2048,
                 "2..=512 voxels each, with cells[1] * volumes <= 2048",
                 (x as f64) * (y as f64) * (z as f64),
             ),

@@ -8,8 +8,11 @@
 
 use std::path::{Path, PathBuf};
 
+use super::check::number;
 use super::constants::{G, R_D, ZERO_CELSIUS_K};
-use super::sounding_formats::{Format, detect, igra2_to_csv, sharppy_to_csv, wyoming_to_csv};
+use super::sounding_formats::{
+    Format, HEIGHT_MAX_M, detect, igra2_to_csv, sharppy_to_csv, wyoming_to_csv,
+};
 use super::thermo::{
     mixing_ratio_from_dewpoint, saturation_mixing_ratio, saturation_vapour_pressure,
 };
@@ -101,16 +104,61 @@ struct Columns {
     header_line: u64,
 }
 
+/// What is wrong with a row the csv crate cannot read, without the
+/// crate's own line number ([`csv_line`] gives the right one).
+fn csv_reason(e: &csv::Error) -> String {
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} fields, expected {expected_len} as in the header"),
+        csv::ErrorKind::Utf8 { err, .. } => format!("not UTF-8 text: {err}"),
+        _ => e.to_string(),
+    }
+}
+
+/// The 1-based line of `text` on which the record at the csv crate's
+/// `position` is. The crate's own line number is not it: it leaves out
+/// blank lines and comment lines ended by `\r\n`, and the position's
+/// byte is where the crate began to look for the record, before the
+/// blank and comment lines it then passed over. Those are passed over
+/// here too.
+fn csv_line(text: &str, pos: Option<&csv::Position>) -> u64 {
+    let b = text.as_bytes();
+    let mut at = pos.map_or(0, |p| p.byte() as usize).min(b.len());
+    loop {
+        match b.get(at) {
+            Some(b'\r' | b'\n') => at += 1,
+            Some(b'#') => {
+                at = b[at..]
+                    .iter()
+                    .position(|&c| c == b'\n')
+                    .map_or(b.len(), |n| at + n + 1);
+            }
+            _ => break,
+        }
+    }
+    b[..at].iter().filter(|&&c| c == b'\n').count() as u64 + 1
+}
+
 impl Columns {
     /// Reads the header: height, pressure and temperature, and a dewpoint
     /// or else a relative humidity column.
-    fn read(reader: &mut csv::Reader<&[u8]>, err: &LineError) -> Result<Self, SoundingError> {
+    fn read(
+        reader: &mut csv::Reader<&[u8]>,
+        text: &str,
+        err: &LineError,
+    ) -> Result<Self, SoundingError> {
         let headers = reader
             .headers()
-            .map_err(|e| err(1, format!("cannot read header: {e}")))?
+            .map_err(|e| {
+                err(
+                    csv_line(text, e.position()),
+                    format!("cannot read header: {}", csv_reason(&e)),
+                )
+            })?
             .clone();
         let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
-        let header_line = reader.position().line().max(1);
+        let header_line = csv_line(text, headers.position());
         let missing = |name: &str| {
             err(
                 header_line,
@@ -140,13 +188,28 @@ impl Columns {
         })
     }
 
-    /// One data row, its values in range.
-    fn row(&self, record: &csv::StringRecord, err: &LineError) -> Result<Row, SoundingError> {
-        let line = record.position().map_or(0, |p| p.line());
+    /// One data row, on `line`, its values in range.
+    fn row(
+        &self,
+        record: &csv::StringRecord,
+        line: u64,
+        err: &LineError,
+    ) -> Result<Row, SoundingError> {
         let field = |c: usize, name: &str| -> Result<Option<f64>, SoundingError> {
             let s = record.get(c).unwrap_or("");
             if s.is_empty() {
                 return Ok(None);
+            }
+            // An unclosed quote runs to the file's end: say so, not all
+            // the lines it took in.
+            if s.contains(['\n', '\r']) {
+                return Err(err(
+                    line,
+                    format!(
+                        "`{name}` is a quoted field that runs past its line \
+                         (a `\"` not closed?), expected a number"
+                    ),
+                ));
             }
             let v: f64 = s
                 .parse()
@@ -166,10 +229,13 @@ impl Columns {
         let p = field(self.pressure, "pressure_hPa")?;
         let t = required(self.temperature, "temperature_C")?;
         let hum = required(self.humidity_column, self.humidity.column())?;
-        if h < 0.0 {
+        if !(0.0..=HEIGHT_MAX_M).contains(&h) {
             return Err(err(
                 line,
-                format!("`height_m` is {h}, expected >= 0 (height above ground)"),
+                format!(
+                    "`height_m` is {}, expected 0..={HEIGHT_MAX_M} m (height above ground)",
+                    number(h)
+                ),
             ));
         }
         if let Some(p) = p
@@ -177,13 +243,13 @@ impl Columns {
         {
             return Err(err(
                 line,
-                format!("`pressure_hPa` is {p}, expected 1..=1200"),
+                format!("`pressure_hPa` is {}, expected 1..=1200", number(p)),
             ));
         }
         if !(-120.0..=70.0).contains(&t) {
             return Err(err(
                 line,
-                format!("`temperature_C` is {t}, expected -120..=70"),
+                format!("`temperature_C` is {}, expected -120..=70", number(t)),
             ));
         }
         match self.humidity {
@@ -194,9 +260,10 @@ impl Columns {
                 return Err(err(
                     line,
                     format!(
-                        "`dewpoint_C` is {hum}, expected -150 or more, and at most \
+                        "`dewpoint_C` is {}, expected -150 or more, and at most \
                          {DEWPOINT_EXCESS_MAX_K} K above `temperature_C` {t} or \
                          {:.0} % relative humidity (it gives {:.0} %)",
+                        number(hum),
                         RH_MAX * 100.0,
                         dewpoint_humidity(hum, t) * 100.0
                     ),
@@ -206,7 +273,8 @@ impl Columns {
                 return Err(err(
                     line,
                     format!(
-                        "`relative_humidity_pct` is {hum}, expected 0..={:.0}",
+                        "`relative_humidity_pct` is {}, expected 0..={:.0}",
+                        number(hum),
                         RH_MAX * 100.0
                     ),
                 ));
@@ -365,14 +433,14 @@ impl Sounding {
             .trim(csv::Trim::All)
             .comment(Some(b'#'))
             .from_reader(text.as_bytes());
-        let columns = Columns::read(&mut reader, &err)?;
+        let columns = Columns::read(&mut reader, text, &err)?;
         let mut rows: Vec<Row> = Vec::new();
         for record in reader.records() {
             let record = record.map_err(|e| {
-                let line = e.position().map_or(0, |p| p.line());
-                err(line, format!("malformed row: {e}"))
+                let line = csv_line(text, e.position());
+                err(line, format!("malformed row: {}", csv_reason(&e)))
             })?;
-            let row = columns.row(&record, &err)?;
+            let row = columns.row(&record, csv_line(text, record.position()), &err)?;
             if let Some(prev) = rows.last() {
                 row.check_above(prev, &err)?;
             }

@@ -6,6 +6,13 @@
 //! original file. Heights above sea level become heights above the lowest
 //! level.
 
+/// The highest level a sounding may have, m above its lowest (in
+/// every format): the scene's bound on heights
+/// (`atmosphere.inversion_base_m`, the band). The pressures are filled
+/// and the atmosphere's table is built metre by metre up to the top, so
+/// a level at 1e15 m never finished loading.
+pub(crate) const HEIGHT_MAX_M: f64 = 1e5;
+
 /// A format of sounding file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
@@ -95,6 +102,16 @@ fn to_csv(lines: &[Option<[f64; 4]>], height: &str) -> Result<String, LineError>
                         ),
                     ));
                 }
+                if *h - ground > HEIGHT_MAX_M {
+                    return Err((
+                        k as u64 + 1,
+                        format!(
+                            "{height} is {h} m, {} m above the lowest level's {ground} m; \
+                             expected at most {HEIGHT_MAX_M} m above it",
+                            *h - ground
+                        ),
+                    ));
+                }
                 below = Some((*h, k));
                 out.push_str(&format!("{},{p},{t},{td}", h - ground));
             }
@@ -114,6 +131,9 @@ fn number(s: &str, line: u64, what: &str) -> Result<Option<f64>, LineError> {
     let v: f64 = s
         .parse()
         .map_err(|_| (line, format!("`{what}` is `{s}`, expected a number")))?;
+    if !v.is_finite() {
+        return Err((line, format!("`{what}` is `{s}`, expected a finite number")));
+    }
     Ok((v > -9998.0).then_some(v))
 }
 

@@ -38,7 +38,11 @@ pub struct SimulateArgs {
     /// Write rows every this many simulated seconds (default: every frame).
     #[arg(long)]
     every_s: Option<f64>,
-    /// Output CSV, one row per parcel per output step (written atomically).
+    /// Output CSV, one row per parcel per output step (written atomically):
+    /// the physics' axes, x and y horizontal and z_m the height (z up;
+    /// `render` and `export` put y up); age_s is negative while a parcel
+    /// waits at the ground for its release (-600: released in 600 s).
+    /// Columns: docs/physics.md, "Parcel curves".
     #[arg(long)]
     out: PathBuf,
 }
