@@ -1133,3 +1133,33 @@ fn parcels_not_yet_released_wait_at_the_release_height() {
         "{waiting} waiting, {released} released"
     );
 }
+
+/// An endless database path that is a folder is an error naming the key
+/// and the folder, before the volumes are built.
+#[test]
+fn an_endless_database_that_is_a_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("volumes")).unwrap();
+    let scene = write(
+        dir.path(),
+        "e.toml",
+        "[simulation]\nmethod = \"endless\"\n\n[simulation.endless]\nvolumes = 3\n\
+         interval_s = 20.0\ncells = [16, 4, 16]\ndatabase = \"volumes\"\n",
+    );
+    let out = dir.path().join("e.png");
+    fails(
+        &mut render(
+            &scene,
+            &out,
+            &["--backend", "cpu", "--width", "32", "--height", "24"],
+        ),
+        1,
+        &[
+            "e.toml:",
+            "`simulation.endless.database`",
+            "volumes, a folder",
+            "expected a file",
+        ],
+    );
+    assert!(!out.exists());
+}

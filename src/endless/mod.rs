@@ -141,6 +141,15 @@ impl Database {
         let Some(path) = cfg.database_path(scene.source.as_deref()) else {
             return Ok((Self::build(scene, cfg, progress)?, Source::Built));
         };
+        if path.is_dir() {
+            return Err(EndlessError::Scene(scene.invalid(
+                "simulation.endless.database",
+                format!(
+                    "names {}, a folder: expected a file to keep the volumes in",
+                    path.display()
+                ),
+            )));
+        }
         let print = fingerprint(scene, cfg);
         if path.exists()
             && let Some(db) = Self::load(&path, print)?
