@@ -187,6 +187,7 @@ pub fn remove_temp_files(dir: &Path, pid: Option<u32>) -> Vec<std::path::PathBuf
 }
 
 /// Encodes an RGB image as PNG and writes it atomically.
+#[cfg(feature = "images")]
 pub fn write_png_atomically(path: &Path, img: &image::RgbImage) -> std::io::Result<()> {
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
@@ -196,6 +197,7 @@ pub fn write_png_atomically(path: &Path, img: &image::RgbImage) -> std::io::Resu
 
 /// Encodes linear RGB radiance as OpenEXR (32-bit float channels, scene
 /// linear, no tone map) and writes it atomically.
+#[cfg(feature = "images")]
 pub fn write_exr_atomically(path: &Path, img: &image::Rgb32FImage) -> std::io::Result<()> {
     let mut exr = Vec::new();
     img.write_to(

@@ -20,11 +20,23 @@
 //! assert!(sim.parcels().pos.iter().all(|x| x.is_finite()));
 //! ```
 
+//! The crate's features: the physics ([`sim`], [`io`]) is always there;
+//! `render` adds the renderers, the scene files, the preparation of a
+//! frame and the endless player; `images` the PNG and OpenEXR writers;
+//! `cli` (the default) all of it with the reports and the `cumulus`
+//! binary.
+
+#[cfg(feature = "render")]
 pub mod endless;
 pub mod io;
+#[cfg(feature = "render")]
 pub mod panel;
+#[cfg(feature = "render")]
 pub mod prepare;
+#[cfg(feature = "render")]
 pub mod render;
+#[cfg(feature = "cli")]
 pub mod report;
+#[cfg(feature = "render")]
 pub mod scene;
 pub mod sim;
