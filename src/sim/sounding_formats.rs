@@ -106,9 +106,10 @@ fn to_csv(lines: &[Option<[f64; 4]>], height: &str) -> Result<String, LineError>
                     return Err((
                         k as u64 + 1,
                         format!(
-                            "{height} is {h} m, {} m above the lowest level's {ground} m; \
+                            "{height} is {} m, {} m above the lowest level's {ground} m; \
                              expected at most {HEIGHT_MAX_M} m above it",
-                            *h - ground
+                            super::check::number(*h),
+                            super::check::number(*h - ground)
                         ),
                     ));
                 }
