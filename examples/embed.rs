@@ -36,8 +36,11 @@ fn main() -> Result<()> {
     let out = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "embed.png".into());
-    // The application's device (any wgpu device works; this one is headless).
-    let ctx = GpuContext::new(wgpu::Backends::all()).context("a GPU adapter")?;
+    // The application's device (any adapter that can draw the clouds,
+    // `requirements::check_adapter`; this one is headless; WGPU_BACKEND
+    // narrows the search).
+    let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+    let ctx = GpuContext::new(backends).context("a GPU adapter")?;
     let (device, queue) = (&ctx.device, &ctx.queue);
     let texture = |label, format, usage| {
         device.create_texture(&wgpu::TextureDescriptor {
@@ -98,8 +101,15 @@ fn main() -> Result<()> {
         ..RenderSettings::default()
     };
     let settings = look.gpu_settings(band, extent);
-    let mut clouds = CloudRenderer::new(device, queue, FORMAT, &settings, &cloud_map, None);
+    let mut clouds = CloudRenderer::new(device, queue, FORMAT, &settings, &cloud_map, None)
+        .context("the cloud renderer on this device")?;
     clouds.resize(WIDTH, HEIGHT);
+    // Each `update_field` makes the light volume stale. Built whole, it
+    // would cost the next frame a whole build (seconds on a software
+    // adapter); built progressively, each frame traces one batch, a
+    // quarter of the photons, and the light follows the clouds over a
+    // few frames.
+    clouds.set_progressive_light(true);
     // Compile the pipelines the frames below use (over the app's depth
     // buffer) now, not in the first frame.
     clouds.warm_up(&[FrameUse::Render { depth: true }]);
@@ -112,7 +122,12 @@ fn main() -> Result<()> {
     let aspect = WIDTH as f32 / HEIGHT as f32;
     let projection = Mat4::perspective_infinite_reverse_rh(60_f32.to_radians(), aspect, 0.5);
     let eye = Vec3::new(0.0, 100.0, 0.0);
+    println!(
+        "{}: 16 frames of {WIDTH}x{HEIGHT}, each a physics step, P and a light batch",
+        ctx.describe()
+    );
     for frame in 0..16 {
+        let start = std::time::Instant::now();
         sim.step();
         sim.project_into(&mut field, band);
         clouds.update_field(queue, &field);
@@ -141,6 +156,14 @@ fn main() -> Result<()> {
         // here), in front of the geometry elsewhere.
         clouds.render(&mut encoder, &target_view, Some(&depth_view), &view)?;
         queue.submit([encoder.finish()]);
+        // Waits for the GPU, so the time below is the frame's (an
+        // application would not wait).
+        device.poll(wgpu::PollType::wait_indefinitely())?;
+        println!(
+            "frame {frame:>2}: {:>7.1} ms (physics, P, light batch, clouds; light volume builds so far: {})",
+            start.elapsed().as_secs_f64() * 1e3,
+            clouds.light_volume_builds().unwrap_or(0)
+        );
     }
     let rgba = ctx.read_texture(&target, 4)?;
     let rgb: Vec<u8> = rgba

@@ -85,8 +85,23 @@ fn fold_tracks(@builtin(global_invocation_id) id: vec3u) {
     light_sum[i] = light_sum[i] * light_fold.x + tracks * light_fold.y;
 }
 
-// The sums as radiance per unit irradiance, through the phase's moments,
-// into the three planes: texel (i, j, k) is cell (i, j, k).
+// Coefficient `k` of the sums of cell `c` smoothed over its layer: the
+// binomial mean of the 3 x 3 cells about it (1-2-1 along x and z),
+// wrapping across the domain.
+fn filter_cells(c: vec3i, k: u32) -> f32 {
+    var sum = 0.0;
+    for (var dk = -1; dk <= 1; dk++) {
+        for (var di = -1; di <= 1; di++) {
+            let w = f32((2 - abs(di)) * (2 - abs(dk)));
+            sum += w * light_sum[light_index(c.x + di, c.y, c.z + dk) * 9u + k];
+        }
+    }
+    return sum / 16.0;
+}
+
+// The sums as radiance per unit irradiance, their directional
+// coefficients (1-8) smoothed (`filter_cells`), through the phase's
+// moments, into the three planes: texel (i, j, k) is cell (i, j, k).
 @compute @workgroup_size(64)
 fn sh_planes(@builtin(global_invocation_id) id: vec3u) {
     let idx = light_invocation(id);
@@ -94,11 +109,12 @@ fn sh_planes(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let scale = transport_scale(frame.sun_dir.xyz, light_step.z);
-    var c = array<f32, 9>();
-    for (var k = 0u; k < 9u; k++) {
-        c[k] = light_sum[idx * 9u + k] * scale;
-    }
     let cell = light_cell(idx);
+    var c = array<f32, 9>();
+    c[0] = light_sum[idx * 9u] * scale;
+    for (var k = 1u; k < 9u; k++) {
+        c[k] = filter_cells(cell, k) * scale;
+    }
     let m1 = PHASE_MOMENT_1;
     let m2 = PHASE_MOMENT_2;
     textureStore(light_plane0, cell, vec4f(c[0], c[1] * m1, c[2] * m1, c[3] * m1));

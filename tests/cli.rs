@@ -342,6 +342,8 @@ fn off_a_terminal_a_run_reports_progress_in_plain_lines() {
             "rendering: 100 %",
             " s simulating and ",
             " s for the light volume",
+            // The default adaptive still says what it marched.
+            " marches a pixel)",
         ],
     );
 }
@@ -1162,4 +1164,41 @@ fn an_endless_database_that_is_a_folder_is_refused() {
         ],
     );
     assert!(!out.exists());
+}
+
+/// `render --stills-report DIR` writes the stills' error against cost
+/// with no picture: each sampling's marches a pixel (uniform: its
+/// offsets; adaptive: between one and its offsets) and its error.
+#[test]
+fn the_stills_report_counts_each_samplings_marches() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shipped("fair_weather.toml");
+    let mut c = cumulus(&["render", "--scene", path(&scene), "--backend", "cpu"]);
+    c.args([
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--light-photons",
+        "16",
+        "--time-s",
+        "600",
+    ]);
+    c.arg("--stills-report").arg(dir.path());
+    let out = stdout(&succeeds(&mut c));
+    assert!(out.contains("stills.csv"), "{out}");
+    let mut r = csv::Reader::from_path(dir.path().join("stills.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+    assert_eq!(rows.len(), 6);
+    for row in &rows {
+        let offsets: f64 = row[1].parse().unwrap();
+        let marches: f64 = row[4].parse().unwrap();
+        let error: f64 = row[5].parse().unwrap();
+        match &row[0] {
+            "uniform" => assert_eq!(marches, offsets),
+            "adaptive" => assert!(marches >= 1.0 && marches < offsets, "{row:?}"),
+            other => panic!("sampling {other}"),
+        }
+        assert!(error.is_finite() && error >= 0.0, "{row:?}");
+    }
 }

@@ -55,7 +55,8 @@ fn renderer(ctx: &GpuContext, sc: &Scene, p: &Prepared) -> CloudRenderer {
         &p.gpu_settings(r, r.quality()),
         &p.cloud_map,
         None,
-    );
+    )
+    .expect("the renderer");
     c.update_field(&ctx.queue, &p.field);
     c.resize(W, H);
     c
@@ -518,7 +519,8 @@ fn an_unblendable_hdr_target_over_depth_is_refused_by_name() {
             &p.gpu_settings(r, r.quality()),
             &p.cloud_map,
             None,
-        );
+        )
+        .expect("the renderer");
         c.update_field(&ctx.queue, &p.field);
         c.resize(W, H);
         let target = textures::create_2d(
@@ -548,4 +550,41 @@ fn an_unblendable_hdr_target_over_depth_is_refused_by_name() {
             }
         }
     }
+}
+
+/// `examples/embed.rs` (built with the other examples) runs as written:
+/// it builds the light volume progressively, so each frame after an
+/// `update_field` traces one batch instead of a whole build, and it says
+/// what every frame did and how long it took.
+#[test]
+fn the_embed_example_reports_each_frame() {
+    if gpu().is_none() {
+        return;
+    }
+    let exe = std::env::current_exe().expect("test path");
+    let dir = exe.parent().and_then(|d| d.parent()).expect("target dir");
+    let embed = dir
+        .join("examples")
+        .join(format!("embed{}", std::env::consts::EXE_SUFFIX));
+    let out = tempfile::tempdir().unwrap();
+    let png = out.path().join("embed.png");
+    let o = std::process::Command::new(embed)
+        .arg(&png)
+        .output()
+        .expect("the example runs");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let frames: Vec<&str> = text.lines().filter(|l| l.starts_with("frame ")).collect();
+    assert_eq!(frames.len(), 16, "{text}");
+    assert!(
+        frames
+            .iter()
+            .all(|l| l.contains(" ms (physics, P, light batch")),
+        "{text}"
+    );
+    assert!(png.is_file());
 }

@@ -805,7 +805,8 @@ fn bad_calls_are_errors_not_panics() {
         &p.gpu_settings(r, r.quality()),
         &p.cloud_map,
         None,
-    );
+    )
+    .expect("the renderer");
     renderer.resize(16, 16);
     // By hand, not `textures::create_2d`: that one never makes a 0x0
     // texture, and the last check needs one.
@@ -864,7 +865,8 @@ fn external_depth_keeps_geometry_and_marches_sky_pixels() {
         &p.gpu_settings(r, r.quality()),
         &p.cloud_map,
         None,
-    );
+    )
+    .expect("the renderer");
     renderer.update_field(&ctx.queue, &p.field);
     renderer.resize(w, h);
     let make = |format, usage| {

@@ -145,3 +145,48 @@ fn a_bad_scene_is_named_in_the_error() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("bad.toml:2"), "{err}");
 }
+
+/// In a small window the control panel starts hidden behind a button, so
+/// the sky fills the window: at 320x180 the left half, where a 300-pixel
+/// panel would sit, is sky and cloud, not the panel's grey.
+#[test]
+fn a_small_window_keeps_its_sky() {
+    if !xvfb() {
+        return;
+    }
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("small.png");
+    let o = run(
+        &[
+            "--scene",
+            "scenes/fair_weather.toml",
+            "--screenshot",
+            shot.to_str().unwrap(),
+            "--frames",
+            "1",
+            "--width",
+            "320",
+            "--height",
+            "180",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&shot).expect("a PNG").to_rgb8();
+    assert_eq!(img.dimensions(), (320, 180));
+    // Below the button, the left half's upper part: blue sky or cloud.
+    let (mut sky, mut n) = (0, 0);
+    for y in 30..70 {
+        for x in 0..160 {
+            let [r, _, b] = img.get_pixel(x, y).0;
+            n += 1;
+            if (b as f32 > 1.2 * r as f32 && b > 80) || r > 120 {
+                sky += 1;
+            }
+        }
+    }
+    assert!(sky * 10 > n * 9, "{sky} of {n} pixels are sky or cloud");
+}

@@ -32,7 +32,8 @@ fn renderer(ctx: &GpuContext, name: &str, tsaa: bool) -> (Scene, CloudRenderer) 
         &p.gpu_settings(r, r.quality()),
         &p.cloud_map,
         p.terrain.as_ref(),
-    );
+    )
+    .expect("the renderer");
     c.update_field(&ctx.queue, &p.field);
     c.resize(W, H);
     (sc, c)

@@ -113,6 +113,11 @@ def scene_variant(base, sun_el, sun_az, yaw, width, height, path, extra=()):
         # at a footprint of a cell, where they have faded out): off in
         # ours too, so both renderers march the same clouds.
         "fine_detail": "false",
+        # The light is what is compared: every pixel the mean of eight
+        # marches, so the still's own sampling (renderer.md, "Error
+        # against cost (stills)") adds nothing to the difference.
+        "cpu_sampling": '"uniform"',
+        "cpu_offsets": "8",
     }
     keys.update(extra)
     out, in_render = [], False

@@ -5,7 +5,9 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result, anyhow};
-use cumulus::render::gpu::{CloudRenderer, FrameUse, GpuContext, GpuSettings, is_hdr};
+use cumulus::render::gpu::context::adapter_preference;
+use cumulus::render::gpu::requirements::check_adapter;
+use cumulus::render::gpu::{CloudRenderer, FrameUse, GpuContext, GpuSettings, RenderError, is_hdr};
 use winit::window::Window;
 
 use crate::world::World;
@@ -45,13 +47,19 @@ impl Gfx {
         let surface = instance
             .create_surface(window.clone())
             .map_err(|e| anyhow!("no GPU adapter can draw to this window ({e}). {NO_ADAPTER}"))?;
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: Some(&surface),
-            apply_limit_buckets: false,
-        }))
-        .map_err(|_| anyhow!("no GPU adapter can draw to this window. {NO_ADAPTER}"))?;
+        // The best adapter that presents to the window and can draw the
+        // clouds; failing that, the best that presents, which
+        // `from_adapter` refuses naming what it lacks.
+        let adapter = pollster::block_on(instance.enumerate_adapters(backends))
+            .into_iter()
+            .filter(|a| a.is_surface_supported(&surface))
+            .min_by_key(|a| {
+                (
+                    check_adapter(a).is_err(),
+                    adapter_preference(a.get_info().device_type),
+                )
+            })
+            .ok_or_else(|| anyhow!("no GPU adapter can draw to this window. {NO_ADAPTER}"))?;
         let ctx = GpuContext::from_adapter(&adapter).context("requesting a device")?;
         let size = window.inner_size();
         let mut config = surface
@@ -74,7 +82,8 @@ impl Gfx {
         if size.width > 0 && size.height > 0 {
             surface.configure(&ctx.device, &config);
         }
-        let clouds = cloud_renderer(&ctx, config.format, world, (size.width, size.height));
+        let clouds = cloud_renderer(&ctx, config.format, world, (size.width, size.height))
+            .context("the cloud renderer on this device")?;
         let timestamps = ctx.timestamps.then(|| timestamp_queries(&ctx.device));
         let egui = egui_wgpu::Renderer::new(
             &ctx.device,
@@ -94,10 +103,12 @@ impl Gfx {
         })
     }
 
-    /// A new cloud renderer for a newly loaded world, at the same size.
-    pub fn rebuild_clouds(&mut self, world: &World) {
+    /// A new cloud renderer for a newly loaded world, at the same size
+    /// (the old one stays if the device refuses the new one).
+    pub fn rebuild_clouds(&mut self, world: &World) -> Result<(), RenderError> {
         let size = self.clouds.size();
-        self.clouds = cloud_renderer(&self.ctx, self.config.format, world, size);
+        self.clouds = cloud_renderer(&self.ctx, self.config.format, world, size)?;
+        Ok(())
     }
 }
 
@@ -106,7 +117,7 @@ fn cloud_renderer(
     format: wgpu::TextureFormat,
     world: &World,
     (width, height): (u32, u32),
-) -> CloudRenderer {
+) -> Result<CloudRenderer, RenderError> {
     let mut clouds = CloudRenderer::new(
         &ctx.device,
         &ctx.queue,
@@ -114,7 +125,7 @@ fn cloud_renderer(
         &settings_of(world),
         &world.cloud_map,
         world.terrain.as_ref(),
-    );
+    )?;
     clouds.update_field(&ctx.queue, &world.field);
     // The clouds change as the demo runs: the light volume follows them a
     // batch of photons a frame instead of a whole build per change.
@@ -122,7 +133,7 @@ fn cloud_renderer(
     clouds.resize(width, height);
     // The window's first frame would otherwise compile them.
     clouds.warm_up(&[FrameUse::Render { depth: false }]);
-    clouds
+    Ok(clouds)
 }
 
 /// Eight timestamp queries (two per pass) and their resolve and read

@@ -53,10 +53,19 @@ struct Args {
     /// Window height, pixels.
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Start with the control panel hidden (F1 toggles it).
+    /// Start with the control panel hidden (F1 or its button toggles it;
+    /// a window under 640 pixels wide starts with it hidden anyway).
     #[arg(long)]
     hide_panel: bool,
 }
+
+/// The control panel's width where the window has room, logical pixels.
+const PANEL_WIDTH: f32 = 300.0;
+/// The most of the window's width the panel takes.
+const PANEL_SHARE: f32 = 0.4;
+/// Windows narrower than this (logical pixels) start with the panel
+/// hidden.
+const PANEL_MIN_WINDOW: u32 = 640;
 
 struct App {
     args: Args,
@@ -153,11 +162,17 @@ impl App {
                 self.world = w;
                 self.camera = Controller::new(self.world.scene.render.camera());
                 self.views = ui::Views::default();
-                if let Some(g) = &mut self.gfx {
-                    g.rebuild_clouds(&self.world);
+                let rebuilt = match &mut self.gfx {
+                    Some(g) => g.rebuild_clouds(&self.world),
+                    None => Ok(()),
+                };
+                if self.gfx.is_some() {
                     self.uploaded = Some(self.world.field_version);
                 }
-                self.message = Some(format!("loaded {}", path.display()));
+                self.message = Some(match rebuilt {
+                    Ok(()) => format!("loaded {}", path.display()),
+                    Err(e) => format!("loaded {}, but the renderer failed: {e}", path.display()),
+                });
             }
             // The old scene stays.
             Err(e) => self.message = Some(format!("could not load: {e}")),
@@ -218,11 +233,21 @@ impl App {
             &self.timings,
         );
         let show_panel = !self.args.hide_panel;
+        let mut toggle_panel = false;
         let mut out = self.egui_ctx.run_ui(raw, |ui| {
+            // The panel takes at most PANEL_SHARE of the window's width, so
+            // a small window keeps most of its sky; hidden, a button (or
+            // F1) brings it back.
+            let width = ui.ctx().content_rect().width();
+            let widest = (PANEL_SHARE * width).max(120.0);
             if show_panel {
                 egui::Panel::left("controls")
-                    .default_size(300.0)
+                    .default_size(PANEL_WIDTH.min(widest))
+                    .max_size(widest)
                     .show(ui, |ui| {
+                        if ui.small_button("hide controls (F1)").clicked() {
+                            toggle_panel = true;
+                        }
                         // Scrolls when the window is shorter than the panel.
                         egui::ScrollArea::vertical().show(ui, |ui| {
                             actions =
@@ -230,10 +255,22 @@ impl App {
                         });
                     });
             }
+            if !show_panel {
+                egui::Area::new(egui::Id::unique("show controls"))
+                    .fixed_pos(egui::pos2(6.0, 6.0))
+                    .show(ui.ctx(), |ui| {
+                        if ui.small_button("controls (F1)").clicked() {
+                            toggle_panel = true;
+                        }
+                    });
+            }
             ui::debug_views(ui.ctx(), world, views);
             ui::overlay(ui.ctx(), timings, &description);
         });
         state.handle_platform_output(window, std::mem::take(&mut out.platform_output));
+        if toggle_panel {
+            self.args.hide_panel = !self.args.hide_panel;
+        }
         Some((actions, out))
     }
 
@@ -493,7 +530,9 @@ impl ApplicationHandler for App {
 }
 
 fn main() -> Result<()> {
-    let args = Args::parse();
+    let mut args = Args::parse();
+    // A small window keeps its sky: the panel starts hidden.
+    args.hide_panel |= args.width < PANEL_MIN_WINDOW;
     let mut app = App::new(args).context("loading the scene")?;
     let event_loop = EventLoop::new().context(
         "no display to open a window on (set DISPLAY, or run under `xvfb-run`); for still pictures use `cumulus render`",

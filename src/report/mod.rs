@@ -9,6 +9,7 @@ pub mod field_stats;
 pub mod gpu_bench;
 pub mod plot;
 pub mod render_quality;
+pub mod still_quality;
 pub mod vdb;
 pub mod volume_export;
 

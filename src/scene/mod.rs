@@ -19,7 +19,7 @@ pub use atmosphere::AtmosphereSection;
 pub use locate::locate_key;
 use locate::{key_at_line, line_col, plain_types};
 pub use projection::ProjectionSection;
-pub use render::{RenderMethod, RenderSettings};
+pub use render::{CpuSampling, RenderMethod, RenderSettings};
 pub use simulation::{EndlessConfig, Method, SimulationSection};
 
 use crate::sim::lift::surface_lcl_height;

@@ -27,6 +27,19 @@ pub enum RenderMethod {
     Spheroids,
 }
 
+/// How a CPU still spends its marches (`[render] cpu_sampling`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CpuSampling {
+    /// One march a pixel, all `cpu_offsets` only where the picture has an
+    /// edge, the dither's grain filtered out of the clouds elsewhere
+    /// (`render::cpu::still_reconstruction`).
+    #[default]
+    Adaptive,
+    /// `cpu_offsets` marches through every pixel, averaged.
+    Uniform,
+}
+
 /// The `[render]` scene table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -84,11 +97,16 @@ pub struct RenderSettings {
     /// light volume with it.
     pub octaves: u32,
     /// Photons the light volume traces per column of its cells (80 m wide)
-    /// (0..=65536; [`crate::render::cpu::light_volume`]). Default 1024: 16
-    /// M photons over the fair-weather domain, the count the light was
-    /// fitted with; fewer give a noisier light (256 scored 0.5 points
-    /// worse per pixel on the backlit view) for a faster build. 0 leaves
-    /// the light volume out (the octaves alone carry multiple scattering).
+    /// (0..=65536; [`crate::render::cpu::light_volume`]). Default 96: 1.5
+    /// M photons over the fair-weather domain, built in about 4 s on a
+    /// 2-core CPU, its directional part smoothed over neighbouring cells
+    /// (`light_volume::filter_cells`). Against the path tracer that is
+    /// 9.1-10.5 % per pixel over the six views, each within a point of
+    /// its figure at 1024 (8.9-9.6 %), the count the light was fitted
+    /// with, which takes 15 times as long to build; 64 leaves the backlit
+    /// view 1.4 points worse (docs/ground_truth/README.md, "Photons
+    /// against error and time"). 0 leaves the light volume out (the
+    /// octaves alone carry multiple scattering).
     pub light_photons: u32,
     /// The analytic sky's aerial-perspective distance, m (> 0). Default
     /// 25000 (the physical sky's haze comes from its air,
@@ -115,18 +133,25 @@ pub struct RenderSettings {
     pub tsaa: bool,
     /// Weight of each new frame in the TSAA history, (0, 1]. Default 0.1.
     pub tsaa_blend: f32,
-    /// CPU pictures: marches per pixel, averaged, march `k` as the GPU's
-    /// TSAA frame `k` (its sub-pixel jitter, which anti-aliases edges, and
-    /// its golden-ratio dither offset, which moves the samples and the
-    /// shadow samples within their steps; `render_still`). 1: one march
-    /// through each pixel's centre, which shows the dither's fine grain
-    /// at 48 steps (1..=64). Default 8: at 4, near clouds' edges show the
-    /// dither's checker, more so with the fine billows, and 8 takes it out
-    /// at 2.1 times the time (30 s against 14 s for view_below_base at
-    /// 640x480 on 2 cores). The endless volumes' pictures
-    /// average the dither offsets through pixel centres (no TSAA on their
-    /// GPU pass); the spheroids' take one march.
+    /// CPU pictures: the marches a pixel takes, averaged, march `k` as the
+    /// GPU's TSAA frame `k` (its sub-pixel jitter, which anti-aliases
+    /// edges, and its golden-ratio dither offset, which moves the samples
+    /// and the shadow samples within their steps; `render_still`): every
+    /// pixel's with `cpu_sampling = "uniform"`, the edges' with
+    /// `"adaptive"` (the rest take one). 1: one march through each
+    /// pixel's centre (1..=64). Default 4: with adaptive sampling on fair
+    /// weather, 8 costs 1.4 times the marches for a still measured 0.09
+    /// levels closer to the converged one (docs/renderer.md, "Error
+    /// against cost (stills)"). The endless volumes' pictures average the
+    /// dither offsets through pixel centres (no TSAA on their GPU pass);
+    /// the spheroids' take one march.
     pub cpu_offsets: u32,
+    /// How CPU stills of the cloud map spend their marches: `"adaptive"`
+    /// (default: one march a pixel, `cpu_offsets` at edges, the grain
+    /// filtered; about a fifth of the marches) or `"uniform"`
+    /// (`cpu_offsets` everywhere). docs/renderer.md, "Error against cost
+    /// (stills)", has each one's error against the converged picture.
+    pub cpu_sampling: CpuSampling,
     /// The cloud map (`[render.cloud_map]`).
     pub cloud_map: CloudMapConfig,
     /// The terrain (`[render.terrain]`), off by default.
@@ -159,7 +184,7 @@ impl Default for RenderSettings {
             steps: 48,
             shadow_steps: 20,
             octaves: 3,
-            light_photons: 1024,
+            light_photons: 96,
             haze_distance_m: 25_000.0,
             max_distance_m: 40_000.0,
             exposure: 1.2,
@@ -168,7 +193,8 @@ impl Default for RenderSettings {
             time_s: 2400.0,
             tsaa: true,
             tsaa_blend: 0.1,
-            cpu_offsets: 8,
+            cpu_offsets: 4,
+            cpu_sampling: CpuSampling::Adaptive,
             cloud_map: Default::default(),
             terrain: TerrainConfig::default(),
             ground: GroundConfig::default(),

@@ -29,14 +29,21 @@ pub struct RenderArgs {
     /// Output picture, written atomically: .png (tone-mapped with ACES
     /// filmic at render.exposure, opened below a 5° sun by
     /// render.auto_exposure; sRGB) or .exr (OpenEXR, linear radiance, no
-    /// tone map). Needed unless --quality-report is given.
-    #[arg(long, required_unless_present = "quality_report")]
+    /// tone map). Needed unless --quality-report or --stills-report is
+    /// given.
+    #[arg(long, required_unless_present_any = ["quality_report", "stills_report"])]
     out: Option<PathBuf>,
     /// Also write the error-against-cost report (render_quality.csv/.png)
     /// into this directory: step counts from 8 to 256 against a 2048-step
     /// reference, at up to 320x240.
     #[arg(long)]
     quality_report: Option<PathBuf>,
+    /// Also write the CPU stills' error against cost (stills.csv) into
+    /// this directory: one march a pixel up to eight, averaged everywhere
+    /// (render.cpu_sampling = "uniform") or at edges ("adaptive"),
+    /// against 32 a pixel, at up to 320x240.
+    #[arg(long)]
+    stills_report: Option<PathBuf>,
     /// Image width in pixels (overrides render.width).
     #[arg(long)]
     width: Option<u32>,
@@ -50,8 +57,9 @@ pub struct RenderArgs {
     #[arg(long)]
     steps: Option<u32>,
     /// Photons the light volume traces per column of its cells (overrides
-    /// render.light_photons, default 1024): fewer for a quick preview
-    /// (the multiply scattered light is noisier), 0 for none.
+    /// render.light_photons, default 64): more for a light closer to the
+    /// path tracer's (1024, the count it was fitted with, takes 18 times
+    /// as long), fewer for a quicker, noisier one, 0 for none.
     #[arg(long)]
     light_photons: Option<u32>,
     /// auto: a hardware GPU when wgpu finds one, else the CPU reference;
@@ -147,10 +155,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
         single_scattering: a.single_scattering,
         ..r.quality()
     };
-    if let Some(dir) = &a.quality_report {
+    if a.quality_report.is_some() || a.stills_report.is_some() {
         // The CPU's frame, its light volume built once here (the GPU
         // builds its own: a GPU picture does not wait for the CPU's).
-        quality_report(&lit_frame(&prepared, r, quality), r, dir)?;
+        let frame = lit_frame(&prepared, r, quality);
+        if let Some(dir) = &a.quality_report {
+            quality_report(&frame, r, dir)?;
+        }
+        if let Some(dir) = &a.stills_report {
+            stills_report(&frame, r, dir)?;
+        }
     }
     if r.renderer == RenderMethod::Spheroids {
         return render_spheroids(gpu.as_ref(), &a, &scene, &prepared, picture);
@@ -245,6 +259,41 @@ fn check_backend_flags(a: &RenderArgs, scene: &Scene, gpu: bool) -> Result<()> {
     Ok(())
 }
 
+/// `--stills-report DIR`: the error against cost of the CPU stills'
+/// samplings (stills.csv), written to `dir` and printed.
+fn stills_report(frame: &Frame, r: &RenderSettings, dir: &Path) -> Result<()> {
+    use cumulus::report::still_quality;
+    crate::create_output_folder(dir)?;
+    let (w, h) = (r.width.min(320), r.height.min(240));
+    let bar = progress_bar(still_quality::STILLS.len() as u64 + 1, "stills");
+    let stills = still_quality::measure_stills(frame, w, h, || bar.inc(1));
+    bar.finish_and_clear();
+    still_quality::write_stills(&stills, w, h, dir)?;
+    println!(
+        "stills at {w}x{h} against {} marches a pixel:\n{:>9} {:>7} {:>8} {:>10} {:>9} {:>6}",
+        still_quality::CONVERGED_OFFSETS,
+        "sampling",
+        "offsets",
+        "marches",
+        "mean_lvls",
+        "p99_lvls",
+        "grain"
+    );
+    for s in &stills {
+        println!(
+            "{:>9} {:>7} {:>8.2} {:>10.3} {:>9.1} {:>6.2}",
+            still_quality::sampling_name(s.sampling),
+            s.offsets,
+            s.marches_per_pixel,
+            s.mean_levels,
+            s.p99_levels,
+            s.grain
+        );
+    }
+    println!("wrote {}/stills.csv", dir.display());
+    Ok(())
+}
+
 /// `--quality-report DIR`: the error against cost of the step counts
 /// (render_quality.csv and .png) and the dither's high-pass energy,
 /// written to `dir` and printed.
@@ -327,16 +376,27 @@ fn render_cpu(
     picture: Option<Picture>,
     simulate_s: f64,
 ) -> Result<()> {
+    use cumulus::render::cpu::still_reconstruction::render_still_adaptive;
     use cumulus::render::cpu::stills::{add_sun_glare, render_still_reporting};
+    use cumulus::scene::CpuSampling;
     let r = &scene.render;
     let built = std::time::Instant::now();
     let frame = lit_frame(prepared, r, quality);
     let light_s = built.elapsed().as_secs_f64();
     let start = std::time::Instant::now();
     let bar = progress_bar(100, "rendering");
-    let mut linear = render_still_reporting(r.width, r.height, &frame, r.cpu_offsets, &|share| {
-        bar.to_share(share)
-    });
+    let report = &|share: f32| bar.to_share(share);
+    let (mut linear, marches) = match r.cpu_sampling {
+        CpuSampling::Adaptive => {
+            let still = render_still_adaptive(r.width, r.height, &frame, r.cpu_offsets, report);
+            let per_pixel = still.marches_per_pixel();
+            (still.linear, per_pixel)
+        }
+        CpuSampling::Uniform => (
+            render_still_reporting(r.width, r.height, &frame, r.cpu_offsets, report),
+            r.cpu_offsets as f64,
+        ),
+    };
     bar.finish_and_clear();
     if picture != Some(Picture::Exr) {
         // The tone-mapped picture gets the sun's glare (`still_srgb8`; the
@@ -348,7 +408,7 @@ fn render_cpu(
 
     write_linear(out, picture, r, &linear)?;
     eprintln!(
-        "rendered {}x{} in {:.2} s after {simulate_s:.2} s simulating and {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        "rendered {}x{} in {:.2} s ({marches:.2} marches a pixel) after {simulate_s:.2} s simulating and {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
         r.height,
         elapsed.as_secs_f64(),
@@ -539,9 +599,9 @@ fn render_endless(
 
     let r = &scene.render;
     let cfg = &scene.simulation.endless;
-    if a.time_frames.is_some() || a.quality_report.is_some() {
+    if a.time_frames.is_some() || a.quality_report.is_some() || a.stills_report.is_some() {
         bail!(
-            "--time-frames and --quality-report are for the cloud map; `cumulus bench --methods` times the volumes"
+            "--time-frames, --quality-report and --stills-report are for the cloud map; `cumulus bench --methods` times the volumes"
         );
     }
     // The physics' frames, then one step per volume compared with the

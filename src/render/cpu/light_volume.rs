@@ -15,10 +15,11 @@
 //! 2. [`super::light_transport::trace`]: [`light_photons`] photons from
 //!    the sun through those cells, their tracks summed as nine
 //!    coefficients a cell (`follow` on the GPU, into fixed-point cells);
-//!    then [`sh_planes`] (the entry of that name on the GPU): the coefficients
-//!    scaled to per unit irradiance and convolved with the phase
-//!    function ([`PHASE_MOMENTS`]), in the three rgba planes the cloud
-//!    pass samples.
+//!    then [`filter_cells`] and [`sh_planes`] (the GPU's `sh_planes` entry
+//!    does both): the coefficients scaled to per unit irradiance, their
+//!    directional part smoothed over the neighbouring cells, and
+//!    convolved with the phase function ([`PHASE_MOMENTS`]), in the three
+//!    rgba planes the cloud pass samples.
 //!
 //! The grid repeats across the domain as the clouds do; photons leave
 //! through the band's floor and ceiling. [`LightVolume::light_toward`]
@@ -27,6 +28,7 @@
 //! eye per unit scattering coefficient.
 
 use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 
 use super::density::{DensityParams, Fields, noise_point, warped_lookup};
 use super::light_grid::{LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons, read_cells};
@@ -51,6 +53,38 @@ pub fn sh_planes(sh: &[[f32; 9]]) -> [Vec<Vec4>; 3] {
             .map(|v| Vec4::new(c(v, 8), 0.0, 0.0, 0.0))
             .collect(),
     ]
+}
+
+/// The transported coefficients `sh` with their directional part
+/// smoothed over neighbouring cells (`filter_cells` and `sh_planes` in
+/// WGSL): coefficients 1-8 of each cell the binomial mean of the 3 x 3
+/// cells about it in its layer (weights 1-2-1 along x and z, wrapping
+/// across the domain as the grid does), coefficient 0 (the fluence) its
+/// own. The directional coefficients are the photons' noisiest; against
+/// the path tracer at 64 photons a column this filter takes 0.4-0.7
+/// points off the per-pixel error, where smoothing the fluence too blurs
+/// the lit tops (0.84 of Mitsuba's at a low sun) and the side view's
+/// flanks (11 % per pixel; docs/ground_truth/README.md).
+pub fn filter_cells(sh: &[[f32; 9]], grid: &LightVolumeGrid) -> Vec<[f32; 9]> {
+    (0..grid.len())
+        .into_par_iter()
+        .map(|idx| {
+            let (i, j, k) = grid.cell(idx);
+            let mut out = [0.0f32; 9];
+            for dk in -1..=1_i32 {
+                for di in -1..=1_i32 {
+                    let w = ((2 - di.abs()) * (2 - dk.abs())) as f32;
+                    let c = &sh[grid.index(i + di, j, k + dk)];
+                    for n in 1..9 {
+                        out[n] += w * c[n];
+                    }
+                }
+            }
+            let mut out = out.map(|v| v / 16.0);
+            out[0] = sh[idx][0];
+            out
+        })
+        .collect()
 }
 
 /// The share of a build's progress given to the cells' extinction (the
@@ -96,14 +130,14 @@ impl LightVolume {
             progress(EXTINCTION_SHARE + (1.0 - EXTINCTION_SHARE) * t)
         });
         progress(1.0);
-        let planes = sh_planes(&sh);
+        let planes = sh_planes(&filter_cells(&sh, &grid));
         Self { grid, sh, planes }
     }
 
     /// The volume for the cells' extinction `sigma`, from `photons`.
     pub fn trace(grid: LightVolumeGrid, sigma: &[f32], sun_dir: Vec3, photons: u32) -> Self {
         let sh = trace(&grid, sigma, sun_dir, photons, LIGHT_SEED);
-        let planes = sh_planes(&sh);
+        let planes = sh_planes(&filter_cells(&sh, &grid));
         Self { grid, sh, planes }
     }
 

@@ -24,6 +24,7 @@ pub mod sky;
 pub mod sky_luts;
 pub mod spheroids;
 pub mod standalone;
+pub mod still_reconstruction;
 pub mod stills;
 pub mod tone_map;
 pub mod volume;

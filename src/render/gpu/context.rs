@@ -3,6 +3,20 @@
 
 use std::sync::mpsc;
 
+use super::requirements::check_adapter;
+
+/// The order adapters are tried in ([`GpuContext::new`], the sky demo):
+/// hardware first, software last.
+pub fn adapter_preference(t: wgpu::DeviceType) -> u8 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
 /// Errors of the headless GPU path.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
@@ -12,6 +26,8 @@ pub enum GpuError {
     NoAdapter,
     #[error("the GPU adapter {adapter} refused a device: {message}")]
     RequestDevice { adapter: String, message: String },
+    #[error("{0}; render with --backend cpu, or use a Vulkan, Metal or D3D12 adapter")]
+    Unsupported(#[from] super::requirements::Unsupported),
     #[error("wgpu reported an error: {0}")]
     Wgpu(String),
     #[error("reading the image back from the GPU failed: {0}")]
@@ -40,26 +56,35 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// The first adapter of `backends` that wgpu offers (high performance
-    /// preferred), with timestamp queries when it has them.
-    /// `Err(NoAdapter)` when there is none. (The binaries pass
+    /// The best adapter of `backends` that can draw the clouds
+    /// ([`check_adapter`]): a discrete GPU before an integrated one, a
+    /// virtual one, then a software one; with timestamp queries when it
+    /// has them. `Err(NoAdapter)` when there is no adapter at all, and
+    /// `Err(Unsupported)`, naming what the best one lacks, when none can
+    /// draw (an OpenGL-only machine). (The binaries pass
     /// `wgpu::Backends::from_env()`, i.e. `WGPU_BACKEND`, when it is set.)
     pub fn new(backends: wgpu::Backends) -> Result<Self, GpuError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = backends;
         let instance = wgpu::Instance::new(desc);
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|_| GpuError::NoAdapter)?;
-        Self::from_adapter(&adapter)
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        adapters.sort_by_key(|a| adapter_preference(a.get_info().device_type));
+        let mut refused = None;
+        for adapter in &adapters {
+            match check_adapter(adapter) {
+                Ok(()) => return Self::from_adapter(adapter),
+                Err(e) => {
+                    refused.get_or_insert(e);
+                }
+            }
+        }
+        Err(refused.map_or(GpuError::NoAdapter, GpuError::Unsupported))
     }
 
-    /// A device on `adapter`.
+    /// A device on `adapter`, refused ([`check_adapter`]) when the
+    /// adapter cannot draw the clouds.
     pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Self, GpuError> {
+        check_adapter(adapter)?;
         let adapter_info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_features = if timestamps {
@@ -70,7 +95,7 @@ impl GpuContext {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("cumulus"),
             required_features,
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            required_limits: super::requirements::limits().using_resolution(adapter.limits()),
             ..Default::default()
         }))
         .map_err(|e| GpuError::RequestDevice {

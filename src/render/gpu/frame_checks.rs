@@ -10,6 +10,8 @@
 /// the checks below find wrong with the target or the depth buffer.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum RenderError {
+    #[error(transparent)]
+    Unsupported(#[from] super::requirements::Unsupported),
     #[error(
         "the depth buffer is {depth_w}x{depth_h} but the renderer is {width}x{height}: call resize() with the target's size"
     )]

@@ -76,15 +76,15 @@ impl Headless {
         (width, height): (u32, u32),
         format: wgpu::TextureFormat,
     ) -> Result<Self, GpuError> {
+        let mut renderer = CloudRenderer::new(
+            &ctx.device,
+            &ctx.queue,
+            format,
+            settings,
+            cloud_map,
+            terrain,
+        )?;
         ctx.checked(|| {
-            let mut renderer = CloudRenderer::new(
-                &ctx.device,
-                &ctx.queue,
-                format,
-                settings,
-                cloud_map,
-                terrain,
-            );
             renderer.update_field(&ctx.queue, field);
             renderer.resize(width, height);
             let target = target(ctx, width, height, format);

@@ -46,9 +46,7 @@ impl From<&LightVolumeGrid> for LightVolumeGridUniforms {
     }
 }
 
-/// The planes' format: filterable, and writable by a compute pass
-/// without extra features.
-const PLANE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub use super::textures::PLANE_FORMAT;
 
 /// The fixed-point cells' unit, m of track (`TRACK_UNIT` in WGSL): a
 /// track's length times its harmonic is rounded to it, far below the
@@ -56,9 +54,12 @@ const PLANE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const TRACK_UNIT: f32 = 1.0 / 256.0;
 /// Photons per column of cells in one batch: its tracks are folded into
 /// the float sums before the next batch, so no cell's 32-bit sum
-/// overflows (a column's 64 photons lay at most a few kilometres of
-/// track in a cell, 2^31 units are 8,400 km).
-pub const BATCH_PER_COLUMN: u32 = 64;
+/// overflows (a column's 24 photons lay at most a few kilometres of
+/// track in a cell, 2^31 units are 8,400 km). A progressive build traces
+/// one batch a frame: a quarter of the default `render.light_photons`
+/// (96), so an application's frame that follows a change of the clouds
+/// costs a quarter of a whole build.
+pub const BATCH_PER_COLUMN: u32 = 24;
 
 /// The stride of `light_step`'s entries (the dynamic offsets' alignment).
 const STEP_STRIDE: u64 = 256;

@@ -11,6 +11,7 @@ pub mod headless;
 mod inputs;
 pub mod light_volume_pass;
 pub mod renderer;
+pub mod requirements;
 pub mod settings;
 pub mod shaders;
 pub mod sky_luts_pass;

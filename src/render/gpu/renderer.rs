@@ -39,6 +39,7 @@ pub use super::frame_checks::RenderError;
 use super::inputs::Inputs;
 use super::light_volume_pass::LightVolumePass;
 pub use super::light_volume_pass::PASS_LIGHT_VOLUME;
+use super::requirements::check_device;
 use super::settings::GpuSettings;
 use super::shaders::Background;
 use super::sky_luts_pass::{SkyTable, TableBuilds};
@@ -113,7 +114,7 @@ fn background(terrain: bool, depth: bool) -> Background {
 ///     &settings,
 ///     &cloud_map,
 ///     None,
-/// );
+/// )?;
 /// clouds.resize(1280, 720);
 /// // Compile the pipelines now, not in the first frame.
 /// clouds.warm_up(&[FrameUse::Render { depth: false }]);
@@ -170,7 +171,10 @@ pub struct CloudRenderer {
 impl CloudRenderer {
     /// Creates the renderer for a target of `target_format`. The cloud map
     /// is uploaded once; P starts empty (clear sky) until
-    /// [`Self::update_field`]. `terrain` builds the terrain pass.
+    /// [`Self::update_field`]. `terrain` builds the terrain pass. `Err`
+    /// ([`RenderError::Unsupported`]) names what `device` lacks
+    /// ([`super::requirements`]; an application can ask its adapter first
+    /// with `requirements::check_adapter`).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -178,7 +182,8 @@ impl CloudRenderer {
         settings: &GpuSettings,
         cloud_map: &CloudMap,
         terrain: Option<&Heightfield>,
-    ) -> Self {
+    ) -> Result<Self, RenderError> {
+        check_device(device)?;
         let sky = settings.sky_params();
         let inputs = Inputs::new(
             device,
@@ -190,7 +195,7 @@ impl CloudRenderer {
         );
         let constants = settings.constants();
         let size = (0, 0);
-        Self {
+        Ok(Self {
             terrain: terrain.map(|h| TerrainPass::new(device, queue, &inputs, &constants, h, size)),
             light: settings.light_volume().then(|| {
                 LightVolumePass::new(
@@ -220,7 +225,7 @@ impl CloudRenderer {
             frame_index: 0,
             timestamps: None,
             last_passes: Vec::new(),
-        }
+        })
     }
 
     /// Uploads a new P (after each physics step). P may change size. The

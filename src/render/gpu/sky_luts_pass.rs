@@ -20,8 +20,7 @@ use crate::render::cpu::sky_luts::{
     radius_at_altitude,
 };
 
-/// Format of the three tables (RGB, alpha 1).
-pub const LUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub use super::textures::LUT_FORMAT;
 /// The compute shaders' workgroup side (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;
 /// Byte offset between the tables' resolved timestamp pairs
