@@ -44,16 +44,12 @@ fn run(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
     c.output().expect("xvfb-run runs")
 }
 
-#[test]
-fn screenshot_shows_sky_and_clouds_in_a_real_window() {
-    if !xvfb() {
-        return;
-    }
-    if common::gpu().is_none() {
-        return;
-    }
+/// The demo on fair weather in a `width x height` window, `--screenshot`
+/// after `frames` frames: its output (it must succeed) and the picture.
+fn screenshot(frames: u32, width: u32, height: u32) -> (std::process::Output, image::RgbImage) {
     let dir = tempfile::tempdir().unwrap();
     let shot = dir.path().join("shot.png");
+    let (frames, width, height) = (frames.to_string(), width.to_string(), height.to_string());
     let o = run(
         &[
             "--scene",
@@ -61,11 +57,11 @@ fn screenshot_shows_sky_and_clouds_in_a_real_window() {
             "--screenshot",
             shot.to_str().unwrap(),
             "--frames",
-            "3",
+            &frames,
             "--width",
-            "800",
+            &width,
             "--height",
-            "450",
+            &height,
         ],
         &[],
     );
@@ -75,13 +71,25 @@ fn screenshot_shows_sky_and_clouds_in_a_real_window() {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     );
+    let img = image::open(&shot).expect("a PNG").to_rgb8();
+    (o, img)
+}
+
+#[test]
+fn screenshot_shows_sky_and_clouds_in_a_real_window() {
+    if !xvfb() {
+        return;
+    }
+    if common::gpu().is_none() {
+        return;
+    }
+    let (o, img) = screenshot(3, 800, 450);
     // --screenshot says how far it has got.
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         err.contains("frame 1 of 3") && err.contains("frame 3 of 3"),
         "{err}"
     );
-    let img = image::open(&shot).expect("a PNG").to_rgb8();
     assert_eq!(img.dimensions(), (800, 450));
     // Right of the control panel (about 300 px), the upper two thirds are
     // sky (blue) with clouds (bright and grey-white).
@@ -157,25 +165,7 @@ fn a_small_window_keeps_its_sky() {
     if common::gpu().is_none() {
         return;
     }
-    let dir = tempfile::tempdir().unwrap();
-    let shot = dir.path().join("small.png");
-    let o = run(
-        &[
-            "--scene",
-            "scenes/fair_weather.toml",
-            "--screenshot",
-            shot.to_str().unwrap(),
-            "--frames",
-            "1",
-            "--width",
-            "320",
-            "--height",
-            "180",
-        ],
-        &[],
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let img = image::open(&shot).expect("a PNG").to_rgb8();
+    let (_, img) = screenshot(1, 320, 180);
     assert_eq!(img.dimensions(), (320, 180));
     // Below the button, the left half's upper part: blue sky or cloud.
     let (mut sky, mut n) = (0, 0);

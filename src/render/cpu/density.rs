@@ -1,5 +1,10 @@
 //! Cloud density inside the height band, from P and the cloud map
 //! (docs/renderer.md, "Density").
+//!
+//! Just over 600 lines on purpose: it is the twin of
+//! `shaders/density.wgsl`, function for function, kept in one file so the
+//! two read side by side (`tests/shader_twins.rs`); its tests are already
+//! in `density_tests.rs`.
 
 use glam::Vec3;
 

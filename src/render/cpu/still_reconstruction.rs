@@ -10,9 +10,9 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::frame::Frame;
-use super::renderer::{RaySample, march_ray, pixel_dither};
+use super::renderer::RaySample;
+use super::stills::{PixelMarches, frame_march, in_bands};
 use super::tone_map::luminance;
-use crate::render::sampling::{frame_offset, jitter};
 
 /// The contrast, in natural log of luminance, between a pixel and any of
 /// its eight neighbours above which the first march does not suffice and
@@ -110,12 +110,14 @@ pub fn render_still_adaptive(
     let h = height as usize;
     let spread = fr.view.pixel_spread(width, height);
     let march = |x: usize, y: usize, k: u32| {
-        let [jx, jy, _] = jitter(k);
-        let dir = fr
-            .view
-            .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);
-        let d = (pixel_dither(x as u32, y as u32) + frame_offset(k)).fract();
-        march_ray(fr.view.eye(), dir, d, spread, fr)
+        let at = PixelMarches {
+            x: x as u32,
+            y: y as u32,
+            width,
+            height,
+            spread,
+        };
+        frame_march(at, fr, k, true)
     };
     // The first march's share of the progress: about its share of the
     // time on the shipped views.
@@ -209,30 +211,4 @@ fn filtered(means: &[RaySample], w: usize, h: usize, x: usize, y: usize) -> Vec3
         Vec3::ZERO
     };
     clouds + background * transmittance
-}
-
-/// Bands of rows a pass's progress is reported in.
-const PROGRESS_BANDS: usize = 50;
-
-/// Runs `each(x, y, pixel)` over every pixel (rayon over rows, in bands),
-/// calling `progress` with the share of rows done after each band.
-fn in_bands(
-    px: &mut [Marched],
-    w: usize,
-    h: usize,
-    each: &(dyn Fn(usize, usize, &mut Marched) + Sync),
-    progress: &dyn Fn(f32),
-) {
-    let band_rows = h.div_ceil(PROGRESS_BANDS).max(1);
-    for (b, band) in px.chunks_mut((w * band_rows).max(1)).enumerate() {
-        band.par_chunks_mut(w.max(1))
-            .enumerate()
-            .for_each(|(r, row)| {
-                let y = b * band_rows + r;
-                for (x, m) in row.iter_mut().enumerate() {
-                    each(x, y, m);
-                }
-            });
-        progress(((b + 1) * band_rows).min(h) as f32 / h.max(1) as f32);
-    }
 }

@@ -105,42 +105,62 @@ fn render_marches_reporting(
     progress: &dyn Fn(f32),
     pick: impl Fn(RaySample) -> Vec4 + Sync,
 ) -> Vec<Vec4> {
-    let w = width as usize;
-    let h = height as usize;
     let spread = fr.view.pixel_spread(width, height);
-    let mut out = vec![Vec4::ZERO; w * h];
+    let mut out = vec![Vec4::ZERO; (width * height) as usize];
+    in_bands(
+        &mut out,
+        width as usize,
+        height as usize,
+        &|x, y, px| {
+            let at = PixelMarches {
+                x: x as u32,
+                y: y as u32,
+                width,
+                height,
+                spread,
+            };
+            *px = pixel_marches(at, fr, frames, jittered, &pick);
+        },
+        progress,
+    );
+    out
+}
+
+/// Runs `each(x, y, pixel)` over every pixel of a `w x h` row-major
+/// image, in [`PROGRESS_BANDS`] bands of rows (each band's rows in
+/// parallel), calling `progress` with the share of the rows done after
+/// each band, on the calling thread.
+pub(crate) fn in_bands<T: Send>(
+    px: &mut [T],
+    w: usize,
+    h: usize,
+    each: &(dyn Fn(usize, usize, &mut T) + Sync),
+    progress: &dyn Fn(f32),
+) {
     let band_rows = h.div_ceil(PROGRESS_BANDS).max(1);
-    for (b, band) in out.chunks_mut((w * band_rows).max(1)).enumerate() {
+    for (b, band) in px.chunks_mut((w * band_rows).max(1)).enumerate() {
         band.par_chunks_mut(w.max(1))
             .enumerate()
             .for_each(|(r, row)| {
                 let y = b * band_rows + r;
-                for (x, px) in row.iter_mut().enumerate() {
-                    let at = PixelMarches {
-                        x: x as u32,
-                        y: y as u32,
-                        width,
-                        height,
-                        spread,
-                    };
-                    *px = pixel_marches(at, fr, frames, jittered, &pick);
+                for (x, p) in row.iter_mut().enumerate() {
+                    each(x, y, p);
                 }
             });
         progress(((b + 1) * band_rows).min(h) as f32 / h.max(1) as f32);
     }
-    out
 }
 
 /// Which pixel [`pixel_marches`] marches through, of an image of
 /// `width x height` whose pixel cone is `spread` radians
 /// ([`crate::render::camera::View::pixel_spread`], once per image).
 #[derive(Clone, Copy)]
-struct PixelMarches {
-    x: u32,
-    y: u32,
-    width: u32,
-    height: u32,
-    spread: f32,
+pub(crate) struct PixelMarches {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+    pub spread: f32,
 }
 
 /// Pixel `(x, y)`'s mean over `frames` marches of `pick` of the ray's
@@ -152,6 +172,19 @@ fn pixel_marches(
     jittered: bool,
     pick: &impl Fn(RaySample) -> Vec4,
 ) -> Vec4 {
+    let n = frames.max(1);
+    let mut sum = Vec4::ZERO;
+    for k in 0..n {
+        sum += pick(frame_march(at, fr, k, jittered));
+    }
+    sum / n as f32
+}
+
+/// Frame `k`'s march through pixel `at`: its sub-pixel jitter (when
+/// `jittered`) and its dither offset, past the jitter's cycle too (the
+/// same as `jitter(k)`'s within it), so that more than JITTER_CYCLE
+/// stills' marches are all distinct.
+pub(crate) fn frame_march(at: PixelMarches, fr: &Frame, k: u32, jittered: bool) -> RaySample {
     let PixelMarches {
         x,
         y,
@@ -159,27 +192,17 @@ fn pixel_marches(
         height,
         spread,
     } = at;
-    let n = frames.max(1);
-    let d0 = pixel_dither(x, y);
-    let mut sum = Vec4::ZERO;
-    for k in 0..n {
-        // Frame k's dither offset, past the jitter's cycle too (the same
-        // as `jitter(k)`'s within it), so that more than JITTER_CYCLE
-        // stills' marches are all distinct.
-        let [jx, jy] = if jittered {
-            let [jx, jy, _] = jitter(k);
-            [jx, jy]
-        } else {
-            [0.0, 0.0]
-        };
-        let offset = frame_offset(k);
-        let dir = fr
-            .view
-            .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);
-        let d = (d0 + offset).fract();
-        sum += pick(march_ray(fr.view.eye(), dir, d, spread, fr));
-    }
-    sum / n as f32
+    let [jx, jy] = if jittered {
+        let [jx, jy, _] = jitter(k);
+        [jx, jy]
+    } else {
+        [0.0, 0.0]
+    };
+    let dir = fr
+        .view
+        .camera_ray(x as f32 + 0.5 + jx, y as f32 + 0.5 + jy, width, height);
+    let d = (pixel_dither(x, y) + frame_offset(k)).fract();
+    march_ray(fr.view.eye(), dir, d, spread, fr)
 }
 
 /// The source of the sun's glare in a `width x height` still of `fr`

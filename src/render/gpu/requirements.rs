@@ -82,15 +82,21 @@ pub const FORMATS: [FormatNeed; 7] = [
 /// The downlevel capabilities the renderer needs: compute shaders.
 pub const DOWNLEVEL: wgpu::DownlevelFlags = wgpu::DownlevelFlags::COMPUTE_SHADERS;
 
-/// The features the renderer needs: none (it uses timestamp queries when
-/// the device has them).
-pub const FEATURES: wgpu::Features = wgpu::Features::empty();
-
 /// The limits the renderer needs: wgpu's downlevel defaults (which
 /// [`GpuContext`](super::GpuContext) requests, raised to the adapter's
-/// texture sizes).
+/// texture sizes). It needs no wgpu feature (it uses timestamp queries
+/// when the device has them).
 pub fn limits() -> wgpu::Limits {
     wgpu::Limits::downlevel_defaults()
+}
+
+/// Each of [`limits`] that `has` falls short of, named.
+fn missing_limits(has: &wgpu::Limits) -> Vec<String> {
+    let mut missing = Vec::new();
+    limits().check_limits_with_fail_fn(has, false, |name, want, allowed| {
+        missing.push(format!("limit {name}: needs {want}, has {allowed}"));
+    });
+    missing
 }
 
 /// An adapter that cannot draw the clouds, and everything it lacks.
@@ -104,12 +110,10 @@ pub struct Unsupported {
 }
 
 /// Whether `adapter` has everything the renderer needs: `Err` lists what
-/// it lacks (features, downlevel flags, limits, texture formats and
-/// their usages).
+/// it lacks (downlevel flags, limits, texture formats and their usages).
 pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), Unsupported> {
     let info = adapter.get_info();
     let missing = missing_capabilities(
-        adapter.features(),
         &adapter.limits(),
         adapter.get_downlevel_capabilities().flags,
         |f| adapter.get_texture_format_features(f),
@@ -131,10 +135,7 @@ pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), Unsupported> {
 /// later frame. (A device does not tell its downlevel flags or its
 /// formats' filtering; [`check_adapter`] checks those on the adapter.)
 pub fn check_device(device: &wgpu::Device) -> Result<(), Unsupported> {
-    let mut missing = Vec::new();
-    limits().check_limits_with_fail_fn(&device.limits(), false, |name, want, has| {
-        missing.push(format!("limit {name}: needs {want}, has {has}"));
-    });
+    let mut missing = missing_limits(&device.limits());
     for need in FORMATS {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let probe = device.create_texture(&wgpu::TextureDescriptor {
@@ -171,24 +172,18 @@ pub fn check_device(device: &wgpu::Device) -> Result<(), Unsupported> {
 
 /// What an adapter of these capabilities lacks, each named ([`check_adapter`]).
 pub fn missing_capabilities(
-    features: wgpu::Features,
     has: &wgpu::Limits,
     downlevel: wgpu::DownlevelFlags,
     format_features: impl Fn(wgpu::TextureFormat) -> wgpu::TextureFormatFeatures,
 ) -> Vec<String> {
     let mut missing = Vec::new();
-    if !features.contains(FEATURES) {
-        missing.push(format!("features {:?}", FEATURES - features));
-    }
     if !downlevel.contains(DOWNLEVEL) {
         missing.push(format!(
             "downlevel flags {:?} (the light volume and the sky's tables are compute passes)",
             DOWNLEVEL - downlevel
         ));
     }
-    limits().check_limits_with_fail_fn(has, false, |name, want, allowed| {
-        missing.push(format!("limit {name}: needs {want}, has {allowed}"));
-    });
+    missing.extend(missing_limits(has));
     for need in FORMATS {
         let f = format_features(need.format);
         if !f.allowed_usages.contains(need.usages) {
@@ -227,9 +222,9 @@ mod tests {
     fn each_missing_capability_is_named() {
         let full = wgpu::Limits::default();
         let all = wgpu::DownlevelFlags::all();
-        assert!(missing_capabilities(wgpu::Features::empty(), &full, all, all_formats).is_empty());
+        assert!(missing_capabilities(&full, all, all_formats).is_empty());
         let no_compute = all - wgpu::DownlevelFlags::COMPUTE_SHADERS;
-        let m = missing_capabilities(wgpu::Features::empty(), &full, no_compute, all_formats);
+        let m = missing_capabilities(&full, no_compute, all_formats);
         assert_eq!(m.len(), 1);
         assert!(m[0].contains("COMPUTE_SHADERS"), "{m:?}");
         let no_r32_target = |f: wgpu::TextureFormat| {
@@ -239,7 +234,7 @@ mod tests {
             }
             x
         };
-        let m = missing_capabilities(wgpu::Features::empty(), &full, all, no_r32_target);
+        let m = missing_capabilities(&full, all, no_r32_target);
         assert_eq!(m.len(), 1, "{m:?}");
         assert!(
             m[0].contains("R32Float") && m[0].contains("RENDER_ATTACHMENT"),
@@ -249,7 +244,7 @@ mod tests {
             max_storage_textures_per_shader_stage: 1,
             ..full
         };
-        let m = missing_capabilities(wgpu::Features::empty(), &small, all, all_formats);
+        let m = missing_capabilities(&small, all, all_formats);
         assert!(
             m.iter()
                 .any(|s| s.contains("max_storage_textures_per_shader_stage")),

@@ -1,5 +1,6 @@
 //! `cumulus render`: simulate a scene, then render one picture on the GPU
-//! or with the CPU reference (and the render-quality report).
+//! or with the CPU reference; the other methods' pictures are in
+//! `methods`, the error-against-cost reports in `reports`.
 
 use std::path::{Path, PathBuf};
 
@@ -11,6 +12,12 @@ use cumulus::render::cpu::frame::{Frame, Quality};
 use cumulus::render::gpu::GpuContext;
 use cumulus::render::gpu::headless::{HDR_FORMAT, TARGET_FORMAT};
 use cumulus::scene::{Method, RenderMethod, RenderSettings, Scene};
+
+mod methods;
+mod reports;
+
+use methods::{render_endless, render_spheroids};
+use reports::{quality_report, stills_report};
 
 use crate::{
     check_output_file, gpu_context, guard_output_file, load_scene, progress_bar, with_overrides,
@@ -259,98 +266,6 @@ fn check_backend_flags(a: &RenderArgs, scene: &Scene, gpu: bool) -> Result<()> {
     Ok(())
 }
 
-/// `--stills-report DIR`: the error against cost of the CPU stills'
-/// samplings (stills.csv), written to `dir` and printed.
-fn stills_report(frame: &Frame, r: &RenderSettings, dir: &Path) -> Result<()> {
-    use cumulus::report::still_quality;
-    crate::create_output_folder(dir)?;
-    let (w, h) = (r.width.min(320), r.height.min(240));
-    let bar = progress_bar(still_quality::STILLS.len() as u64 + 1, "stills");
-    let stills = still_quality::measure_stills(frame, w, h, || bar.inc(1));
-    bar.finish_and_clear();
-    still_quality::write_stills(&stills, w, h, dir)?;
-    println!(
-        "stills at {w}x{h} against {} marches a pixel:\n{:>9} {:>7} {:>8} {:>10} {:>9} {:>6}",
-        still_quality::CONVERGED_OFFSETS,
-        "sampling",
-        "offsets",
-        "marches",
-        "mean_lvls",
-        "p99_lvls",
-        "grain"
-    );
-    for s in &stills {
-        println!(
-            "{:>9} {:>7} {:>8.2} {:>10.3} {:>9.1} {:>6.2}",
-            still_quality::sampling_name(s.sampling),
-            s.offsets,
-            s.marches_per_pixel,
-            s.mean_levels,
-            s.p99_levels,
-            s.grain
-        );
-    }
-    println!("wrote {}/stills.csv", dir.display());
-    Ok(())
-}
-
-/// `--quality-report DIR`: the error against cost of the step counts
-/// (render_quality.csv and .png) and the dither's high-pass energy,
-/// written to `dir` and printed.
-fn quality_report(frame: &Frame, r: &RenderSettings, dir: &Path) -> Result<()> {
-    use cumulus::report::render_quality;
-    crate::create_output_folder(dir)?;
-    let (w, h) = (r.width.min(320), r.height.min(240));
-    let bar = progress_bar(render_quality::STEPS.len() as u64 + 2, "rendering");
-    let report = render_quality::measure(frame, w, h, &render_quality::STEPS, || bar.inc(1));
-    let (hw, hh) = (w.min(160), h.min(120));
-    let hp = render_quality::measure_highpass(frame, hw, hh);
-    bar.finish_and_clear();
-    render_quality::write(&report, dir)?;
-    render_quality::write_highpass(&hp, dir)?;
-    println!(
-        "reference ({} steps) took {:.2} s at {w}x{h}",
-        render_quality::REFERENCE_STEPS,
-        report.reference_wall_s
-    );
-    println!(
-        "{:>6} {:>9} {:>11} {:>10}",
-        "steps", "wall_s", "mean_error", "max_error"
-    );
-    for row in &report.rows {
-        println!(
-            "{:>6} {:>9.4} {:>11.5} {:>10.4}",
-            row.steps, row.wall_s, row.mean_error, row.max_error
-        );
-    }
-    match report.chosen {
-        Some(i) => println!(
-            "least-cost step count with mean error <= {}: {}",
-            render_quality::TARGET_MEAN_ERROR,
-            report.rows[i].steps
-        ),
-        None => println!(
-            "no step count reached mean error <= {}",
-            render_quality::TARGET_MEAN_ERROR
-        ),
-    }
-    println!(
-        "high-pass energy of {} cloud pixels at {hw}x{hh}, against {} steps x {} frames: \
-         one frame {:.2}x, {} frames averaged (TSAA) {:.2}x",
-        hp.cloud_pixels,
-        render_quality::HIGHPASS_REFERENCE_STEPS,
-        cumulus::render::sampling::JITTER_CYCLE,
-        hp.one_frame_ratio(),
-        cumulus::render::sampling::JITTER_CYCLE,
-        hp.converged_ratio()
-    );
-    println!(
-        "wrote {0}/render_quality.csv, {0}/render_quality.png and {0}/highpass.csv",
-        dir.display()
-    );
-    Ok(())
-}
-
 /// The CPU's frame of `prepared` with its light volume, built with a
 /// progress bar (nothing shown when there is none to build).
 fn lit_frame<'a>(prepared: &'a Prepared, r: &RenderSettings, quality: Quality) -> Frame<'a> {
@@ -513,163 +428,6 @@ fn render_gpu(
             }
         }
     }
-    Ok(())
-}
-
-/// `render` with `[render] renderer = "spheroids"`: the pseudo-spheroid
-/// renderer on the GPU, or its CPU twin.
-fn render_spheroids(
-    gpu: Option<&GpuContext>,
-    a: &RenderArgs,
-    scene: &Scene,
-    prepared: &Prepared,
-    picture: Option<Picture>,
-) -> Result<()> {
-    use cumulus::render::cpu::sky::sun_direction;
-    use cumulus::render::cpu::spheroids::{LightGrid, render_spheroids as cpu_render};
-    use cumulus::render::gpu::spheroids::SpheroidRenderer;
-
-    let r = &scene.render;
-    if a.time_frames.is_some() {
-        bail!(
-            "--time-frames times the cloud map; `cumulus bench` times the spheroids (methods.csv)"
-        );
-    }
-    let Some(out) = &a.out else { return Ok(()) };
-    let spheroids = prepared.spheroids();
-    let start = std::time::Instant::now();
-    match gpu {
-        Some(ctx) => {
-            if picture == Some(Picture::Exr) {
-                bail!(
-                    "{}: the spheroid renderer writes PNG on the GPU; use --backend cpu for OpenEXR",
-                    out.display()
-                );
-            }
-            eprintln!("backend: gpu ({})", ctx.describe());
-            let settings = prepared.gpu_settings(r, r.quality());
-            let mut s = SpheroidRenderer::new(
-                &ctx.device,
-                &ctx.queue,
-                TARGET_FORMAT,
-                &settings,
-                prepared.cloud_map.noise(),
-            );
-            s.update_spheroids(&spheroids);
-            write_rgb8(
-                out,
-                r.width,
-                r.height,
-                s.read_rgb8(ctx, &r.camera(), r.width, r.height)?,
-            )?;
-        }
-        None => {
-            // The spheroids light themselves (their light grid): no light
-            // volume.
-            let frame = prepared.density_frame(r, r.quality());
-            let sun = sun_direction(r.sun_elevation_deg, r.sun_azimuth_deg);
-            let grid = LightGrid::build(&spheroids, sun, frame.density.extinction_per_m);
-            let linear = cpu_render(r.width, r.height, &frame, &spheroids, &grid);
-            write_linear(out, picture, r, &linear)?;
-        }
-    }
-    eprintln!(
-        "rendered {}x{} with {} pseudo-spheroids in {:.2} s; wrote {}",
-        r.width,
-        r.height,
-        spheroids.len(),
-        start.elapsed().as_secs_f64(),
-        out.display()
-    );
-    Ok(())
-}
-
-/// `render` with `[simulation] method = "endless"`: the database built,
-/// the first moment of its playback drawn by the volume renderer on the
-/// GPU, or by its CPU twin.
-fn render_endless(
-    gpu: Option<&GpuContext>,
-    a: &RenderArgs,
-    scene: &Scene,
-    picture: Option<Picture>,
-) -> Result<()> {
-    use cumulus::endless::{Database, Player, Source};
-    use cumulus::render::cpu::volume::render_volume;
-    use cumulus::render::gpu::volume_pass::VolumeRenderer;
-
-    let r = &scene.render;
-    let cfg = &scene.simulation.endless;
-    if a.time_frames.is_some() || a.quality_report.is_some() || a.stills_report.is_some() {
-        bail!(
-            "--time-frames, --quality-report and --stills-report are for the cloud map; `cumulus bench --methods` times the volumes"
-        );
-    }
-    // The physics' frames, then one step per volume compared with the
-    // others (the player's distances).
-    let frames = Prepared::frames(scene)
-        + (cfg.volumes.saturating_sub(1) as f64 * cfg.interval_s / scene.physics.dt_s).ceil()
-            as u64
-        + cfg.volumes as u64;
-    let bar = progress_bar(frames, "simulating, sampling and comparing the volumes");
-    let (db, source) = Database::load_or_build(scene, cfg, || bar.inc(1))?;
-    bar.finish_and_clear();
-    let whence = match source {
-        Source::Built => format!("built in {:.1} s", db.build_s),
-        Source::Read(p) => format!("read from {} (built in {:.1} s)", p.display(), db.build_s),
-        Source::Written(p) => format!("built in {:.1} s, wrote {}", db.build_s, p.display()),
-    };
-    eprintln!(
-        "database: {} volumes of {}x{}x{} ({:.1} MB) {whence}",
-        db.len(),
-        db.dims[0],
-        db.dims[1],
-        db.dims[2],
-        db.bytes() as f64 / 1e6,
-    );
-    let Some(out) = &a.out else { return Ok(()) };
-    let mut player = Player::new(&db, cfg.similarity, scene.physics.seed);
-    let (stack, params) = db.stack(player.at(0.0, db.interval_s));
-    match gpu {
-        Some(ctx) => {
-            if picture == Some(Picture::Exr) {
-                bail!(
-                    "{}: the volume renderer writes PNG on the GPU; use --backend cpu for OpenEXR",
-                    out.display()
-                );
-            }
-            eprintln!("backend: gpu ({})", ctx.describe());
-            let settings = db.gpu_settings(r);
-            // The land's fields read the cloud map's detail volume.
-            let p = Prepared::unsimulated(scene)?;
-            let mut v = VolumeRenderer::new(
-                &ctx.device,
-                &ctx.queue,
-                TARGET_FORMAT,
-                &settings,
-                &stack,
-                params,
-                p.cloud_map.noise(),
-            )?;
-            write_rgb8(
-                out,
-                r.width,
-                r.height,
-                v.read_rgb8(ctx, &r.camera(), r.width, r.height)?,
-            )?;
-        }
-        None => {
-            let p = Prepared::unsimulated(scene)?;
-            let frame = p.density_frame(r, r.quality());
-            let linear = render_volume(r.width, r.height, &frame, &params, &stack, r.cpu_offsets);
-            write_linear(out, picture, r, &linear)?;
-        }
-    }
-    eprintln!(
-        "rendered {}x{} from the volumes; wrote {}",
-        r.width,
-        r.height,
-        out.display()
-    );
     Ok(())
 }
 
