@@ -162,17 +162,21 @@ impl App {
                 self.world = w;
                 self.camera = Controller::new(self.world.scene.render.camera());
                 self.views = ui::Views::default();
-                let rebuilt = match &mut self.gfx {
-                    Some(g) => g.rebuild_clouds(&self.world),
-                    None => Ok(()),
-                };
-                if self.gfx.is_some() {
-                    self.uploaded = Some(self.world.field_version);
-                }
-                self.message = Some(match rebuilt {
-                    Ok(()) => format!("loaded {}", path.display()),
-                    Err(e) => format!("loaded {}, but the renderer failed: {e}", path.display()),
-                });
+                // A new renderer holds the new P; if the device refused it,
+                // the old renderer stays and gets the new P next frame.
+                self.message = Some(
+                    match self.gfx.as_mut().map(|g| g.rebuild_clouds(&self.world)) {
+                        Some(Err(e)) => {
+                            format!("loaded {}, but the renderer failed: {e}", path.display())
+                        }
+                        rebuilt => {
+                            if rebuilt.is_some() {
+                                self.uploaded = Some(self.world.field_version);
+                            }
+                            format!("loaded {}", path.display())
+                        }
+                    },
+                );
             }
             // The old scene stays.
             Err(e) => self.message = Some(format!("could not load: {e}")),
