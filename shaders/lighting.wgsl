@@ -80,7 +80,13 @@ fn shadow_ray_length(p: vec3f, sun_dir: vec3f) -> f32 {
 // CPU's `forward_step_factor`): up to 1 + FORWARD_STEP_BOOST toward the
 // sun, where the sunlight scattered once is most of a pixel's light.
 fn forward_step_factor(cos_theta: f32) -> f32 {
-    return 1.0 + FORWARD_STEP_BOOST * smoothstep(FORWARD_COS_MIN, FORWARD_COS_MAX, cos_theta);
+    return 1.0 + FORWARD_STEP_BOOST * toward_sun(cos_theta);
+}
+
+// How much of a primary ray's view is toward the sun, 0 to 1 (the CPU's
+// `toward_sun`).
+fn toward_sun(cos_theta: f32) -> f32 {
+    return smoothstep(FORWARD_COS_MIN, FORWARD_COS_MAX, cos_theta);
 }
 
 // The steps of a shadow ray of `length` m: `steps` over SHADOW_STEP_SPAN_M
@@ -90,6 +96,38 @@ fn forward_step_factor(cos_theta: f32) -> f32 {
 fn shadow_step_count(steps: u32, length: f32, forward: f32) -> u32 {
     let along = clamp(length / SHADOW_STEP_SPAN_M, 1.0, SHADOW_STEP_FACTOR_MAX);
     return u32(ceil(f32(steps) * min(along * forward, SHADOW_STEP_FACTOR_MAX)));
+}
+
+// With a light volume, the shadow ray's near part: NEAR_SHADOW_STEPS (at
+// most `steps`, times `forward`) over NEAR_SHADOW_M; the volume's
+// precomputed depth beyond (the CPU's `near_sun_optical_depth`).
+const NEAR_SHADOW_M: f32 = 200.0;
+const NEAR_SHADOW_STEPS: u32 = 6u;
+
+fn near_step_count(steps: u32, forward: f32) -> u32 {
+    return u32(ceil(f32(min(steps, NEAR_SHADOW_STEPS)) * forward));
+}
+
+// The part of the shadow ray from p the march reads density along with
+// a light volume: its length, steps, and whether any of the ray is left
+// beyond for the volume's depth; up to the whole ray toward the sun (the
+// CPU's `near_shadow_ray`).
+struct NearShadowRay {
+    length: f32,
+    count: u32,
+    rest: bool,
+}
+
+fn near_shadow_ray(p: vec3f, sun_dir: vec3f, steps: u32, forward: f32, toward: f32) -> NearShadowRay {
+    let full = shadow_ray_length(p, sun_dir);
+    let near = min(full, NEAR_SHADOW_M);
+    let near_count = near_step_count(steps, forward);
+    let full_count = max(shadow_step_count(steps, full, forward), near_count);
+    var r: NearShadowRay;
+    r.length = near + (full - near) * toward;
+    r.count = near_count + u32(floor(f32(full_count - near_count) * toward + 0.5));
+    r.rest = toward < 1.0 && full > NEAR_SHADOW_M;
+    return r;
 }
 
 // The light's six fitted gains (the CPU's `LightGains`).

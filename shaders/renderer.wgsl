@@ -119,6 +119,9 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
     var shadow_length = 0.0;
     var shadow_t = 0.0;
     var tau = 0.0;
+    var lit_left = false;
+    var lit_rest = false;
+    let toward = toward_sun(cos_theta);
     loop {
         // What this iteration reads: the lit sample's next shadow step,
         // else (its light added first) the next sub-sample or interval end.
@@ -132,6 +135,7 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
             q = lit_p + sun_dir * (shadow_t + offset * dt);
             if height_fraction(q.y) > 1.0 {
                 k = shadow_count;
+                lit_left = true;
             } else {
                 kind = 2u;
                 q_footprint = lit_footprint;
@@ -140,6 +144,9 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
         if kind != 2u {
             if lit {
                 lit = false;
+                if light_volume_bound() && SHADOW_STEPS > 0u && lit_rest && !lit_left {
+                    tau += sun_depth_at(lit_p + sun_dir * shadow_t);
+                }
                 let eta = clamp((lit_p.y - frame.band.x) / (frame.band.y - frame.band.x), 0.0, 1.0);
                 let ambient = ambient_light(sky_top, ground, eta);
                 let diffused = light_gains().fluence * light_toward(lit_p, -dir);
@@ -197,7 +204,16 @@ fn march_ray(origin: vec3f, dir: vec3f, dither: f32, max_t: f32) -> CloudSample 
                 tau = 0.0;
                 shadow_t = 0.0;
                 shadow_length = shadow_ray_length(q, sun_dir);
-                shadow_count = shadow_step_count(SHADOW_STEPS, shadow_length, forward);
+                lit_left = false;
+                lit_rest = false;
+                if light_volume_bound() {
+                    let r = near_shadow_ray(q, sun_dir, SHADOW_STEPS, forward, toward);
+                    shadow_length = r.length;
+                    shadow_count = r.count;
+                    lit_rest = r.rest;
+                } else {
+                    shadow_count = shadow_step_count(SHADOW_STEPS, shadow_length, forward);
+                }
                 parts = shadow_parts(shadow_count);
                 k = 0u;
             }

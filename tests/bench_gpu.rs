@@ -44,13 +44,14 @@ fn bench_quick_writes_well_formed_results() {
     let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
     assert_eq!(
         header,
-        "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,sky,aerial,frames,p_covered,median_ms,p95_ms,timing"
+        "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,sky,aerial,frames,p_covered,median_ms,p95_ms,timing,reads_mean,reads_max"
             .split(',')
             .collect::<Vec<_>>()
     );
     let col = |n: &str| header.iter().position(|h| h == n).unwrap();
     let mut groups = std::collections::BTreeSet::new();
     let (mut timed, mut total) = (0, 0);
+    let mut feature_reads = Vec::new();
     let mut skies = std::collections::BTreeSet::new();
     for rec in r.records() {
         total += 1;
@@ -78,8 +79,37 @@ fn bench_quick_writes_well_formed_results() {
             rec[col("p95_ms")].parse().unwrap(),
         );
         assert!(p >= m, "p95 {p} < median {m}");
+        // The cloud map's frames count their density reads per pixel:
+        // at least the one a pixel whose ray crosses the band, at most
+        // the mean's own bound; the shadows-off row reads less than the
+        // defaults.
+        if &rec[col("renderer")] == "cloud_map" {
+            let (mean, max): (f64, f64) = (
+                rec[col("reads_mean")].parse().unwrap(),
+                rec[col("reads_max")].parse().unwrap(),
+            );
+            assert!(
+                mean > 0.0 && max >= mean && max.is_finite(),
+                "reads {mean} / {max}"
+            );
+            if &rec[col("group")] == "features" {
+                feature_reads.push((rec[col("shadow_steps")].to_owned(), mean));
+            }
+        }
         timed += 1;
     }
+    // The defaults (the first features row) read more than the frame
+    // without shadows, which reads no shadow ray.
+    let defaults = feature_reads.first().expect("a features row").1;
+    let unshadowed = feature_reads
+        .iter()
+        .find(|(steps, _)| steps == "0")
+        .expect("a shadows-off row")
+        .1;
+    assert!(
+        unshadowed < defaults,
+        "reads without shadows {unshadowed}, defaults {defaults}"
+    );
     assert_eq!(
         total,
         2 + 4 + FEATURES.len() + 2 * 4,

@@ -1067,3 +1067,61 @@ fn a_reflected_rays_march_does_not_step_over_clouds() {
         "opacity {marched:.3} against {fine:.3}: {ratio:.3}"
     );
 }
+
+/// With a light volume the march reads the density only along the
+/// shadow rays' near part (away from the sun) and takes the sun's depth
+/// beyond from the volume: fewer reads for the same clouds, and on
+/// average the optical depth it finds stays near the whole ray's. Toward
+/// the sun it marches the whole ray. Counted in reads, not time.
+#[test]
+fn a_light_volume_spares_the_shadow_rays_reads() {
+    use cumulus::render::cpu::renderer::shadow_depth;
+    let cm = cloud_map();
+    let p = ProjectedField::uniform(32, 32, [0.7, 0.8, 1.0]);
+    let mut fr = small_frame(&p, &cm);
+    let alone = fr;
+    let sun = sun_direction(fr.sun_elevation_deg, fr.sun_azimuth_deg);
+    let light = LightVolume::build(&fr.fields, &fr.density, sun, 8);
+    fr.light = Some(&light);
+    let d = fr.density;
+    let ray = ShadowSteps {
+        steps: 20,
+        forward: 1.0,
+        offset: 0.3,
+    };
+    let (mut reads, mut all_reads, mut tau, mut all_tau, mut lit) = (0, 0, 0.0, 0.0, 0);
+    for i in 0..2000 {
+        let p = Vec3::new(
+            (37.0 * i as f32) % d.map_extent_m,
+            d.band_bottom_m
+                + (0.1 + 0.5 * ((i % 7) as f32 / 7.0)) * (d.band_top_m - d.band_bottom_m),
+            (53.0 * i as f32 + 11.0) % d.map_extent_m,
+        );
+        if density_at(p, &fr.fields, &d, true, 10.0) <= 0.0 {
+            continue;
+        }
+        lit += 1;
+        let a = shadow_depth(p, sun, ray, 0.0, 10.0, &fr);
+        let b = shadow_depth(p, sun, ray, 0.0, 10.0, &alone);
+        reads += a.reads;
+        all_reads += b.reads;
+        tau += a.tau as f64;
+        all_tau += b.tau as f64;
+        // Looking at the sun: the whole ray, the same reads.
+        let c = shadow_depth(p, sun, ray, 1.0, 10.0, &fr);
+        assert_eq!(c.reads, b.reads);
+        assert!(
+            (c.tau - b.tau).abs() <= 1e-4 * b.tau.max(1e-3),
+            "{c:?} {b:?}"
+        );
+    }
+    eprintln!(
+        "{lit} lit samples: {reads} reads against {all_reads}; depth {tau:.1} against {all_tau:.1}"
+    );
+    assert!(lit > 50, "{lit} samples in cloud");
+    assert!(reads * 2 < all_reads, "{reads} reads against {all_reads}");
+    assert!(
+        (tau - all_tau).abs() < 0.25 * all_tau,
+        "depth {tau} against {all_tau}"
+    );
+}

@@ -152,6 +152,12 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             lighting::SHADOW_STEP_FACTOR_MAX as f64,
         ),
         ("FORWARD_STEP_BOOST", lighting::FORWARD_STEP_BOOST as f64),
+        ("NEAR_SHADOW_M", lighting::NEAR_SHADOW_M as f64),
+        ("NEAR_SHADOW_STEPS", lighting::NEAR_SHADOW_STEPS as f64),
+        (
+            "SUN_DEPTH_STEPS_MAX",
+            light_grid::SUN_DEPTH_STEPS_MAX as f64,
+        ),
         ("FORWARD_COS_MIN", lighting::FORWARD_COS_MIN as f64),
         ("FORWARD_COS_MAX", lighting::FORWARD_COS_MAX as f64),
         ("OCTAVE_SCATTERING", lighting::OCTAVE_SCATTERING as f64),
@@ -472,7 +478,10 @@ const MIRRORS: &[(&str, &[&str])] = &[
     ),
     (
         "light_volume_build.wgsl",
-        &["src/render/cpu/light_volume.rs"],
+        &[
+            "src/render/cpu/light_volume.rs",
+            "src/render/cpu/light_grid.rs",
+        ],
     ),
     ("spheroids.wgsl", &["src/render/cpu/spheroids.rs"]),
     ("volume.wgsl", &["src/render/cpu/volume.rs"]),

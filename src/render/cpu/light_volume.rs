@@ -31,7 +31,9 @@ use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::density::{DensityParams, Fields, noise_point, warped_lookup};
-use super::light_grid::{LIGHT_SEED, LightVolumeGrid, cell_extinction, light_photons, read_cells};
+use super::light_grid::{
+    LIGHT_SEED, LightVolumeGrid, cell_extinctions, light_photons, read_cells, sun_depth,
+};
 use super::light_transport::{PHASE_MOMENTS, SH_BAND, trace, trace_reporting};
 use super::lighting::sh9;
 
@@ -39,7 +41,8 @@ use super::lighting::sh9;
 /// unit irradiance, [`trace`]'s): each coefficient times its band's
 /// [`PHASE_MOMENTS`], coefficients 0-3, 4-7 and 8 (then zeros) in turn
 /// (the `sh_planes` entry in WGSL). The light scattered toward `ω` is the dot
-/// product of the planes with [`sh9`]`(ω)`.
+/// product of the planes with [`sh9`]`(ω)`. The third plane's second
+/// channel is left for [`with_sun_depth`].
 pub fn sh_planes(sh: &[[f32; 9]]) -> [Vec<Vec4>; 3] {
     let c = |v: &[f32; 9], k: usize| v[k] * PHASE_MOMENTS[SH_BAND[k]];
     [
@@ -87,6 +90,22 @@ pub fn filter_cells(sh: &[[f32; 9]], grid: &LightVolumeGrid) -> Vec<[f32; 9]> {
         .collect()
 }
 
+/// `planes` with the sun's optical depth from each cell's centre
+/// ([`sun_depth`] of the cells' extinction `sigma`) in the third plane's
+/// second channel, which the cloud pass reads beyond its shadow rays' near
+/// steps (the `sh_planes` entry in WGSL writes it there too).
+pub fn with_sun_depth(
+    mut planes: [Vec<Vec4>; 3],
+    sigma: &[f32],
+    grid: &LightVolumeGrid,
+    sun_dir: Vec3,
+) -> [Vec<Vec4>; 3] {
+    for (texel, depth) in planes[2].iter_mut().zip(sun_depth(sigma, grid, sun_dir)) {
+        texel.y = depth;
+    }
+    planes
+}
+
 /// The share of a build's progress given to the cells' extinction (the
 /// rest is the photons'): about its share of the time on fair weather.
 const EXTINCTION_SHARE: f32 = 0.05;
@@ -123,21 +142,26 @@ impl LightVolume {
         progress: &dyn Fn(f32),
     ) -> Self {
         let grid = LightVolumeGrid::new(d);
-        let sigma = cell_extinction(&grid, f, d);
+        let (sigma, sun_sigma) = cell_extinctions(&grid, f, d, sun_dir);
         progress(EXTINCTION_SHARE);
         let photons = light_photons(&grid, per_column);
         let sh = trace_reporting(&grid, &sigma, sun_dir, photons, LIGHT_SEED, &|t| {
             progress(EXTINCTION_SHARE + (1.0 - EXTINCTION_SHARE) * t)
         });
+        let planes = with_sun_depth(
+            sh_planes(&filter_cells(&sh, &grid)),
+            &sun_sigma,
+            &grid,
+            sun_dir,
+        );
         progress(1.0);
-        let planes = sh_planes(&filter_cells(&sh, &grid));
         Self { grid, sh, planes }
     }
 
     /// The volume for the cells' extinction `sigma`, from `photons`.
     pub fn trace(grid: LightVolumeGrid, sigma: &[f32], sun_dir: Vec3, photons: u32) -> Self {
         let sh = trace(&grid, sigma, sun_dir, photons, LIGHT_SEED);
-        let planes = sh_planes(&filter_cells(&sh, &grid));
+        let planes = with_sun_depth(sh_planes(&filter_cells(&sh, &grid)), sigma, &grid, sun_dir);
         Self { grid, sh, planes }
     }
 
@@ -157,6 +181,15 @@ impl LightVolume {
             + b.dot(Vec4::new(y[4], y[5], y[6], y[7]))
             + c.x * y[8];
         s.max(0.0)
+    }
+
+    /// The sun's optical depth from world point `p` through the clouds'
+    /// mean extinction ([`with_sun_depth`]), read where `p` reads P, as
+    /// [`Self::light_toward`] reads (`sun_depth_at` in WGSL).
+    #[inline]
+    pub fn sun_depth_at(&self, p: Vec3, map_extent_m: f32) -> f32 {
+        let q = noise_point(p, warped_lookup(p.x, p.z, map_extent_m), map_extent_m);
+        read_cells(&self.planes[2], &self.grid, q).y
     }
 }
 

@@ -252,3 +252,60 @@ fn the_filter_smooths_the_directional_light_and_keeps_the_fluence() {
         "noise {after} after against {before} before"
     );
 }
+
+/// Through uniform cells the sun's depth from a cell's centre is the
+/// extinction times the path to the grid's top, along a high sun and a
+/// low one; a path longer than SHADOW_RAY_M stops there. Behind the
+/// ball (from below it, toward the sun) the depth is the ball's; beside
+/// it, none.
+#[test]
+fn the_sun_depth_integrates_the_cells_toward_the_sun() {
+    use crate::render::cpu::light_grid::sun_depth;
+    use crate::render::cpu::lighting::SHADOW_RAY_M;
+    let g = grid(UVec3::new(16, 8, 16), 100.0);
+    let top = g.bottom_m + 800.0;
+    let uniform = vec![0.002f32; g.len()];
+    for sun in [
+        Vec3::new(0.3, 0.9, 0.2).normalize(),
+        Vec3::new(0.99, 0.06, 0.1).normalize(),
+    ] {
+        let depth = sun_depth(&uniform, &g, sun);
+        for idx in [0, 300, g.len() - 1] {
+            let (i, j, k) = g.cell(idx);
+            let path = ((top - g.centre(i, j, k).y) / sun.y).min(SHADOW_RAY_M);
+            let expected = 0.002 * path;
+            assert!(
+                (depth[idx] - expected).abs() < 1e-3 * expected,
+                "sun {sun}, cell {idx}: {} vs {expected}",
+                depth[idx]
+            );
+        }
+    }
+    // A vertical sun over a ball of 0.03/m 1 km across: under its middle
+    // the path crosses it (up to 30 optical depths), a column beside it
+    // sees clear air.
+    let g = grid(UVec3::new(32, 8, 32), 100.0);
+    let ball = cloud_ball(&g, Vec3::new(1600.0, 1600.0, 1600.0));
+    let depth = sun_depth(&ball, &g, Vec3::Y);
+    let under = depth[g.index(15, 0, 15)];
+    let beside = depth[g.index(2, 0, 2)];
+    assert!(under > 10.0 && under < 31.0, "under the ball {under}");
+    assert_eq!(beside, 0.0);
+}
+
+/// A cell's extinction as the sun sees it: the mean where its samples
+/// agree, less than the mean where cloud fills part of it (light passes
+/// through the clear part), and at least the extinction of the clear
+/// part's share alone.
+#[test]
+fn a_part_filled_cell_lets_the_sun_through_its_clear_part() {
+    use crate::render::cpu::light_grid::sun_extinction;
+    let even = sun_extinction(&[0.01; 8], 80.0);
+    assert!((even - 0.01).abs() < 1e-6, "{even}");
+    let half = [0.05, 0.0, 0.05, 0.0, 0.05, 0.0, 0.05, 0.0];
+    let seen = sun_extinction(&half, 80.0);
+    let mean = 0.025;
+    // Half the light crosses unhindered: at most ln 2 / 80 m.
+    assert!(seen < mean && seen <= 2f32.ln() / 80.0 + 1e-6, "{seen}");
+    assert!(seen > 0.0);
+}

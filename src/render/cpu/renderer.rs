@@ -12,7 +12,8 @@ use super::frame::{Frame, MIN_TRANSMITTANCE, diffused_light};
 use super::land::{flat_ground_albedo, terrain_albedo};
 use super::lighting::{
     ALBEDO, ShadowSteps, ambient_light, cloud_shadow, forward_step_factor, integrate_step,
-    light_gains, shadow_offset, sun_optical_depth, sun_scattering,
+    light_gains, near_sun_optical_depth, shadow_march, shadow_offset, shadow_ray_length,
+    shadow_step_count, sun_scattering, toward_sun,
 };
 use super::sea::sea_reflection_change;
 use super::sea::sea_waves_at;
@@ -32,6 +33,10 @@ pub struct RaySample {
     /// premultiplied: `radiance = clouds + transmittance · background`.
     pub clouds: Vec3,
     pub transmittance: f32,
+    /// The density reads the clouds' march took (its shadow rays' too;
+    /// the ground's shadow is not counted): what `debug_sample_count`
+    /// counts on the GPU.
+    pub reads: u32,
 }
 
 /// The pixel's offset of its march samples within their steps, in `(0,
@@ -130,6 +135,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             radiance: background,
             clouds: Vec3::ZERO,
             transmittance: 1.0,
+            reads: 0,
         };
     };
     let log_ratio = ((t1 + NEAR_M) / (t0 + NEAR_M)).ln();
@@ -147,6 +153,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
         forward: forward_step_factor(cos),
         offset: shadow_offset(dither),
     };
+    let toward = toward_sun(cos);
     let mut transmittance = 1.0_f32;
     let mut light = Vec3::ZERO;
     let mut depth_weighted = 0.0_f32;
@@ -156,10 +163,12 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
     // angles get several samples, and empty sky costs one density lookup
     // per interval.
     let mut sigma_a = density_at(origin + dir * t0, &fr.fields, d, true, spread * t0);
+    let mut reads = 1;
     let mut ta = t0;
     'march: for i in 0..steps {
         let tb = march_distance(t0, log_ratio, (i + 1) as f32 / steps as f32);
         let sigma_b = density_at(origin + dir * tb, &fr.fields, d, true, spread * tb);
+        reads += 1;
         let touched = sigma_a > 0.0 || sigma_b > 0.0;
         sigma_a = sigma_b;
         let (n, h) = if touched {
@@ -174,10 +183,13 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             let p = origin + dir * t;
             let footprint = spread * t;
             let sigma_t = density_at(p, &fr.fields, d, true, footprint);
+            reads += 1;
             if sigma_t <= 0.0 {
                 continue;
             }
-            let tau_sun = sun_optical_depth(p, sun_dir, shadow_ray, footprint, &fr.fields, d);
+            let shadow = shadow_depth(p, sun_dir, shadow_ray, toward, footprint, fr);
+            let tau_sun = shadow.tau;
+            reads += shadow.reads;
             let eta = ((p.y - d.band_bottom_m) / (d.band_top_m - d.band_bottom_m)).clamp(0.0, 1.0);
             // Sky light from above, darker toward the cloud base, and the
             // ground's from below.
@@ -217,6 +229,46 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
         radiance: clouds + background * transmittance,
         clouds,
         transmittance,
+        reads,
+    }
+}
+
+/// The sun's optical depth from the lit sample `p` of a primary ray
+/// `toward` the sun ([`toward_sun`]; `reads`: the density reads it
+/// took): with a light volume, the shadow ray's near part
+/// ([`near_sun_optical_depth`]) and the volume's precomputed depth
+/// beyond it ([`crate::render::cpu::light_volume::LightVolume::sun_depth_at`]);
+/// without one, the whole shadow ray ([`shadow_march`], as
+/// [`super::lighting::sun_optical_depth`] takes it). The WGSL march does
+/// the same in its one loop.
+pub fn shadow_depth(
+    p: Vec3,
+    sun_dir: Vec3,
+    ray: ShadowSteps,
+    toward: f32,
+    footprint: f32,
+    fr: &Frame,
+) -> super::lighting::ShadowMarch {
+    let d = &fr.density;
+    if ray.steps == 0 {
+        return shadow_march(p, sun_dir, 0.0, 0, ray.offset, footprint, &fr.fields, d);
+    }
+    match fr.light {
+        Some(v) => {
+            let (mut near, rest) =
+                near_sun_optical_depth(p, sun_dir, ray, toward, footprint, &fr.fields, d);
+            if rest && !near.left_band {
+                near.tau += v.sun_depth_at(p + sun_dir * near.travelled, d.map_extent_m);
+            }
+            near
+        }
+        None => {
+            let length = shadow_ray_length(p, sun_dir, d);
+            let count = shadow_step_count(ray.steps, length, ray.forward);
+            shadow_march(
+                p, sun_dir, length, count, ray.offset, footprint, &fr.fields, d,
+            )
+        }
     }
 }
 

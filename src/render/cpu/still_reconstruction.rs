@@ -44,6 +44,7 @@ struct Marched {
     radiance: Vec3,
     clouds: Vec3,
     transmittance: f32,
+    reads: u32,
     marches: u32,
 }
 
@@ -52,6 +53,7 @@ impl Marched {
         self.radiance += s.radiance;
         self.clouds += s.clouds;
         self.transmittance += s.transmittance;
+        self.reads += s.reads;
         self.marches += 1;
     }
 
@@ -61,6 +63,7 @@ impl Marched {
             radiance: self.radiance / n,
             clouds: self.clouds / n,
             transmittance: self.transmittance / n,
+            reads: self.reads,
         }
     }
 }

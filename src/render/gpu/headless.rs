@@ -185,4 +185,44 @@ impl Headless {
         renderer.set_timestamp_queries(None);
         t
     }
+
+    /// The density reads of one frame from `camera`, per output pixel
+    /// ([`DensityReads`]): the frame marched again with
+    /// `debug_sample_count`, which writes each pixel's count (its shadow
+    /// rays' reads too) in place of its clouds, then the settings
+    /// restored (and the history restarted). A count that does not depend
+    /// on the machine, beside the milliseconds.
+    pub fn density_reads(
+        &mut self,
+        ctx: &GpuContext,
+        camera: &impl ToView,
+    ) -> Result<DensityReads, GpuError> {
+        let settings = *self.renderer.settings();
+        let mut counting = settings;
+        counting.debug_sample_count = true;
+        counting.tsaa = None;
+        self.renderer.set_settings(&counting);
+        let counted =
+            self.render(ctx, camera, 1)
+                .and_then(|()| match self.renderer.cloud_layer() {
+                    Some(layer) => ctx.read_rgba16f(layer),
+                    None => Ok(Vec::new()),
+                });
+        self.renderer.set_settings(&settings);
+        let counts = counted?;
+        let n = counts.len().max(1) as f64;
+        Ok(DensityReads {
+            mean: counts.iter().map(|c| c[0] as f64).sum::<f64>() / n,
+            max: counts.iter().map(|c| c[0]).fold(0.0, f32::max),
+        })
+    }
+}
+
+/// Density reads per output pixel of one frame ([`Headless::density_reads`]):
+/// the march's samples and its shadow rays', read back as half floats
+/// (exact to 2,048).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DensityReads {
+    pub mean: f64,
+    pub max: f32,
 }

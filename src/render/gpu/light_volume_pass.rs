@@ -201,7 +201,8 @@ impl LightVolumePass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let sigma = storage(device, "light_volume.extinction", cells);
+        // The mean extinction, then the sun's (`cell_extinctions`).
+        let sigma = storage(device, "light_volume.extinction", 2 * cells);
         let tracks = storage(device, "light_volume.tracks", 9 * cells);
         let sums = storage(device, "light_volume.sums", 9 * cells);
         let plane = |k: usize| {

@@ -76,7 +76,7 @@ pub const LIGHT_TRANSPORT: &str = include_str!("../../../shaders/light_transport
 pub const LIGHT_VOLUME_BUILD: &str = include_str!("../../../shaders/light_volume_build.wgsl");
 
 /// `light_toward` where there is no light volume: nothing transported.
-const NO_LIGHT: &str = "fn light_toward(p: vec3f, to_eye: vec3f) -> f32 {\n    return 0.0;\n}\n";
+const NO_LIGHT: &str = "fn light_toward(p: vec3f, to_eye: vec3f) -> f32 {\n    return 0.0;\n}\n\nfn light_volume_bound() -> bool {\n    return false;\n}\n\nfn sun_depth_at(p: vec3f) -> f32 {\n    return 0.0;\n}\n";
 
 /// The cloud pass's bindings of the light volume (group 2: its three
 /// planes and their sampler) and its read.
@@ -97,6 +97,21 @@ fn light_toward(p: vec3f, to_eye: vec3f) -> f32 {
     let y = sh9(to_eye);
     let s = dot(a, vec4f(y[0], y[1], y[2], y[3])) + dot(b, vec4f(y[4], y[5], y[6], y[7])) + c.x * y[8];
     return max(s, 0.0);
+}
+
+// The march reads the sun's optical depth beyond its shadow rays' near
+// steps from the light volume (the CPU's `Frame::light` is some).
+fn light_volume_bound() -> bool {
+    return true;
+}
+
+// The sun's optical depth from p through the clouds' mean extinction
+// (the third plane's second channel), read where p reads P (the CPU's
+// `LightVolume::sun_depth_at`).
+fn sun_depth_at(p: vec3f) -> f32 {
+    let q = noise_point(p, warped_lookup(p.x, p.z));
+    let uvw = vec3f(q.x / frame.map.x, (q.y - frame.band.x) / (frame.band.y - frame.band.x), q.z / frame.map.x);
+    return textureSampleLevel(light_plane2, light_sampler, uvw, 0.0).y;
 }
 ";
 

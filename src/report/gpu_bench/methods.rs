@@ -121,7 +121,7 @@ pub(super) fn compare_methods(
         progress(&format!("methods: {method}, cloud map"));
         let p = Prepared::from_scene(sc, || {})?;
         let covered = p.field.covered_fraction();
-        let t = time_cloud_map(ctx, &p, r, o)?;
+        let (t, _) = time_cloud_map(ctx, &p, r, o)?;
         let step = step_cost(sc, &p.cloud_map, samples)?;
         let p_bytes = field_texels(&p.field).len() * 2;
         rows.push(method_row(

@@ -99,6 +99,11 @@ pub struct Row {
     /// "gpu" (timestamp queries) or "wall" (CPU wall time, submit to idle);
     /// "skipped" when the frame was predicted too slow to run.
     pub timing: &'static str,
+    /// Density reads per output pixel of one frame, mean and max (the
+    /// cloud map's renderer; NaN for the spheroids): a cost that does not
+    /// depend on the machine.
+    pub reads_mean: f64,
+    pub reads_max: f64,
 }
 
 /// Physics, projection and upload against the frame, per parcel count.
@@ -270,8 +275,15 @@ pub fn run(
             ..sc.render.clone()
         };
         progress(&format!("resolution {w}x{h}"));
-        let t = time_cloud_map(ctx, &p, &r, o)?;
-        rows.push(row("resolution", "cloud_map", &r, &p, Some(&t), o.frames));
+        let (t, reads) = time_cloud_map(ctx, &p, &r, o)?;
+        rows.push(row(
+            "resolution",
+            "cloud_map",
+            &r,
+            &p,
+            (Some(&t), Some(reads)),
+            o.frames,
+        ));
     }
     for c in COVERAGES {
         let r = RenderSettings {
@@ -279,13 +291,25 @@ pub fn run(
             ..sc.render.clone()
         };
         progress(&format!("coverage {c}"));
-        let t = time_cloud_map(ctx, &p, &r, o)?;
-        rows.push(row("coverage", "cloud_map", &r, &p, Some(&t), o.frames));
+        let (t, reads) = time_cloud_map(ctx, &p, &r, o)?;
+        rows.push(row(
+            "coverage",
+            "cloud_map",
+            &r,
+            &p,
+            (Some(&t), Some(reads)),
+            o.frames,
+        ));
     }
     let tweaks: [Tweak; 8] = [
         |_| {},
         |r| r.tsaa = false,
-        |r| r.terrain.enabled = true,
+        // Hills under the camera: raised by their relief, so it stands
+        // above them whatever the ground under it.
+        |r| {
+            r.terrain.enabled = true;
+            r.camera_position_m[1] += r.terrain.relief_m;
+        },
         |r| r.shadow_steps = 0,
         |r| r.octaves = 0,
         |r| r.detail_strength = 0.0,
@@ -301,13 +325,13 @@ pub fn run(
         } else {
             Prepared::from_scene(&sc, || {})?
         };
-        let t = time_cloud_map(ctx, &p2, &s2.render, o)?;
+        let (t, reads) = time_cloud_map(ctx, &p2, &s2.render, o)?;
         rows.push(row(
             "features",
             "cloud_map",
             &s2.render,
             &p2,
-            Some(&t),
+            (Some(&t), Some(reads)),
             o.frames,
         ));
     }
@@ -318,23 +342,37 @@ pub fn run(
         let (scn, pn) = prepare(&base, n)?;
         let r = &scn.render;
         progress(&format!("parcels {n}: cloud map"));
-        let t = time_cloud_map(ctx, &pn, r, o)?;
+        let (t, reads) = time_cloud_map(ctx, &pn, r, o)?;
         let frame_ms = t.median();
-        rows.push(row("parcels", "cloud_map", r, &pn, Some(&t), o.frames));
+        rows.push(row(
+            "parcels",
+            "cloud_map",
+            r,
+            &pn,
+            (Some(&t), Some(reads)),
+            o.frames,
+        ));
         let predicted_s = last_per_parcel.map(|(m, ms)| ms * n as f64 / m as f64 * 1e-3);
         if predicted_s.is_some_and(|s| s > o.max_frame_s) {
             progress(&format!(
                 "parcels {n}: spheroids skipped (predicted {:.0} s a frame)",
                 predicted_s.unwrap_or(0.0)
             ));
-            rows.push(row("parcels", "per_parcel", r, &pn, None, 0));
+            rows.push(row("parcels", "per_parcel", r, &pn, (None, None), 0));
         } else {
             progress(&format!("parcels {n}: spheroids"));
             let mut sp = spheroid_renderer(ctx, &pn, r);
             sp.resize(r.width, r.height);
             let tb = time_pass(ctx, r, o, |e, v, c, q| sp.render(e, v, c, q))?;
             last_per_parcel = Some((n, tb.median()));
-            rows.push(row("parcels", "per_parcel", r, &pn, Some(&tb), o.frames));
+            rows.push(row(
+                "parcels",
+                "per_parcel",
+                r,
+                &pn,
+                (Some(&tb), None),
+                o.frames,
+            ));
         }
         physics.push(physics_in_frame(
             ctx,

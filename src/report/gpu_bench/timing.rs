@@ -5,7 +5,7 @@ use super::{BenchOptions, Row};
 use crate::prepare::Prepared;
 use crate::render::camera::Camera;
 use crate::render::cpu::sky::SkyModel;
-use crate::render::gpu::headless::TARGET_FORMAT;
+use crate::render::gpu::headless::{DensityReads, TARGET_FORMAT};
 use crate::render::gpu::spheroids::SpheroidRenderer;
 use crate::render::gpu::timer::{FrameTimes, time_frames};
 use crate::render::gpu::{GpuContext, GpuError, textures};
@@ -36,15 +36,18 @@ fn features_of(r: &RenderSettings) -> Features {
     }
 }
 
-/// Times the cloud-map renderer on `p` with `r`.
+/// Times the cloud-map renderer on `p` with `r`, and counts one frame's
+/// density reads per pixel ([`crate::render::gpu::headless::Headless::density_reads`]).
 pub(super) fn time_cloud_map(
     ctx: &GpuContext,
     p: &Prepared,
     r: &RenderSettings,
     o: &BenchOptions,
-) -> Result<FrameTimes, GpuError> {
+) -> Result<(FrameTimes, DensityReads), GpuError> {
     let mut hl = p.headless(ctx, &p.gpu_settings(r, r.quality()), r.width, r.height)?;
-    hl.time_frames(ctx, &r.camera(), o.warmup, o.frames)
+    let t = hl.time_frames(ctx, &r.camera(), o.warmup, o.frames)?;
+    let reads = hl.density_reads(ctx, &r.camera())?;
+    Ok((t, reads))
 }
 
 /// The spheroid renderer of `p`'s parcels with `r`'s settings.
@@ -99,7 +102,7 @@ pub(super) fn row(
     renderer: &'static str,
     r: &RenderSettings,
     p: &Prepared,
-    t: Option<&FrameTimes>,
+    (t, reads): (Option<&FrameTimes>, Option<DensityReads>),
     frames: u32,
 ) -> Row {
     let f = features_of(r);
@@ -122,5 +125,7 @@ pub(super) fn row(
         median_ms: t.map_or(f64::NAN, FrameTimes::median),
         p95_ms: t.map_or(f64::NAN, FrameTimes::p95),
         timing: t.map_or("skipped", FrameTimes::source),
+        reads_mean: reads.map_or(f64::NAN, |r| r.mean),
+        reads_max: reads.map_or(f64::NAN, |r| r.max as f64),
     }
 }

@@ -12,12 +12,12 @@ use crate::report::plot::{Series, bars_png, loglog_png};
 pub fn write(report: &Report, dir: &Path) -> Result<(), ReportError> {
     let path = dir.join("bench.csv");
     write_atomically(&path, |out| {
-        writeln!(out, "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,sky,aerial,frames,p_covered,median_ms,p95_ms,timing")?;
+        writeln!(out, "group,renderer,width,height,coverage,parcels,tsaa,terrain,shadow_steps,octaves,detail,sky,aerial,frames,p_covered,median_ms,p95_ms,timing,reads_mean,reads_max")?;
         for r in &report.rows {
             writeln!(
                 out,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{}",
-                r.group, r.renderer, r.width, r.height, r.coverage, r.parcels, r.tsaa, r.terrain, r.shadow_steps, r.octaves, r.detail, r.sky, r.aerial, r.frames, r.p_covered, r.median_ms, r.p95_ms, r.timing
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{},{:.1},{:.0}",
+                r.group, r.renderer, r.width, r.height, r.coverage, r.parcels, r.tsaa, r.terrain, r.shadow_steps, r.octaves, r.detail, r.sky, r.aerial, r.frames, r.p_covered, r.median_ms, r.p95_ms, r.timing, r.reads_mean, r.reads_max
             )?;
         }
         Ok(())

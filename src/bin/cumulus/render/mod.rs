@@ -427,6 +427,11 @@ fn render_gpu(
                 );
             }
         }
+        let reads = hl.density_reads(ctx, &r.camera())?;
+        println!(
+            "density reads a pixel a frame: mean {:.1}, max {:.0}",
+            reads.mean, reads.max
+        );
     }
     Ok(())
 }
