@@ -342,8 +342,9 @@ fn off_a_terminal_a_run_reports_progress_in_plain_lines() {
             "rendering: 100 %",
             " s simulating and ",
             " s for the light volume",
-            // The default adaptive still says what it marched.
-            " marches a pixel)",
+            // The default adaptive still says what it marched and read.
+            " marches, ",
+            " density reads a pixel)",
         ],
     );
 }

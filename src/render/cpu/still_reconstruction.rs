@@ -78,12 +78,20 @@ pub struct AdaptiveStill {
     pub marches: u64,
     /// Pixels that took every march (edges).
     pub edge_pixels: u64,
+    /// Density reads of all marches together, their shadow rays' too
+    /// (`RaySample::reads`).
+    pub reads: u64,
 }
 
 impl AdaptiveStill {
     /// Marches per pixel, on average.
     pub fn marches_per_pixel(&self) -> f64 {
         self.marches as f64 / self.linear.len().max(1) as f64
+    }
+
+    /// Density reads per pixel, on average.
+    pub fn reads_per_pixel(&self) -> f64 {
+        self.reads as f64 / self.linear.len().max(1) as f64
     }
 }
 
@@ -164,6 +172,7 @@ pub fn render_still_adaptive(
         linear,
         marches: px.iter().map(|m| m.marches as u64).sum(),
         edge_pixels: edge.iter().filter(|e| **e).count() as u64,
+        reads: px.iter().map(|m| m.reads as u64).sum(),
     }
 }
 

@@ -301,15 +301,19 @@ fn render_cpu(
     let start = std::time::Instant::now();
     let bar = progress_bar(100, "rendering");
     let report = &|share: f32| bar.to_share(share);
-    let (mut linear, marches) = match r.cpu_sampling {
+    let (mut linear, cost) = match r.cpu_sampling {
         CpuSampling::Adaptive => {
             let still = render_still_adaptive(r.width, r.height, &frame, r.cpu_offsets, report);
-            let per_pixel = still.marches_per_pixel();
-            (still.linear, per_pixel)
+            let cost = format!(
+                "{:.2} marches, {:.0} density reads a pixel",
+                still.marches_per_pixel(),
+                still.reads_per_pixel()
+            );
+            (still.linear, cost)
         }
         CpuSampling::Uniform => (
             render_still_reporting(r.width, r.height, &frame, r.cpu_offsets, report),
-            r.cpu_offsets as f64,
+            format!("{} marches a pixel", r.cpu_offsets),
         ),
     };
     bar.finish_and_clear();
@@ -323,7 +327,7 @@ fn render_cpu(
 
     write_linear(out, picture, r, &linear)?;
     eprintln!(
-        "rendered {}x{} in {:.2} s ({marches:.2} marches a pixel) after {simulate_s:.2} s simulating and {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
+        "rendered {}x{} in {:.2} s ({cost}) after {simulate_s:.2} s simulating and {light_s:.2} s for the light volume ({} steps, {} shadow steps, {}; P {:.0} % covered, cloud band {:.0}-{:.0} m); wrote {}",
         r.width,
         r.height,
         elapsed.as_secs_f64(),
