@@ -89,7 +89,10 @@ pub struct RenderSettings {
     /// path tracer on a 1024-cell grid, the backlit view's single
     /// scattering measured 12.4 % off per pixel at 20, 9.5 % at 32, 9.0 %
     /// at 64, and 35 % at 12 with the samples at their steps' centres;
-    /// docs/ground_truth/single_scattering.sh).
+    /// docs/ground_truth/single_scattering.sh). With a light volume a ray
+    /// away from the sun takes at most 6 of them over its first 200 m and
+    /// the sun's depth beyond from the volume
+    /// (`render::cpu::lighting::near_shadow_ray`).
     pub shadow_steps: u32,
     /// Multiple-scattering octaves beyond the first (0..=3). Default 3
     /// (the light was fitted to the path tracer with 3). 0 turns multiple
