@@ -9,9 +9,11 @@
 //!
 //! Built once per field, sun and density change, in two steps, each a
 //! WGSL entry of the same name in `shaders/light_volume_build.wgsl`:
-//! 1. [`cell_extinction`] ([`super::light_grid`]): the mean σ_t of each
-//!    cell, the renderer's own `density_at` averaged over eight points of
-//!    the cell;
+//! 1. `cell_extinction` ([`cell_extinctions`] in
+//!    [`super::light_grid`]): the mean σ_t of each cell, the renderer's
+//!    own `density_at` averaged over eight points of the cell, and the
+//!    extinction the sunlight sees there
+//!    ([`super::light_grid::sun_extinction`]);
 //! 2. [`super::light_transport::trace`]: [`light_photons`] photons from
 //!    the sun through those cells, their tracks summed as nine
 //!    coefficients a cell (`follow` on the GPU, into fixed-point cells);
@@ -19,7 +21,9 @@
 //!    does both): the coefficients scaled to per unit irradiance, their
 //!    directional part smoothed over the neighbouring cells, and
 //!    convolved with the phase function ([`PHASE_MOMENTS`]), in the three
-//!    rgba planes the cloud pass samples.
+//!    rgba planes the cloud pass samples, with the sun's optical depth
+//!    from each cell in the third plane's spare channel
+//!    ([`with_sun_depth`]).
 //!
 //! The grid repeats across the domain as the clouds do; photons leave
 //! through the band's floor and ceiling. [`LightVolume::light_toward`]
@@ -125,7 +129,7 @@ pub struct LightVolume {
 
 impl LightVolume {
     /// Builds the volume for the clouds of `f` and `d` under the sun
-    /// `sun_dir`: [`cell_extinction`], then `per_column` photons for each
+    /// `sun_dir`: [`cell_extinctions`], then `per_column` photons for each
     /// column of cells ([`light_photons`], [`LIGHT_SEED`]).
     pub fn build(f: &Fields, d: &DensityParams, sun_dir: Vec3, per_column: u32) -> Self {
         Self::build_reporting(f, d, sun_dir, per_column, &|_| {})

@@ -169,7 +169,7 @@ pub fn sun_optical_depth(
 /// with a light volume the march reads the density only this far toward
 /// the sun and the sun's optical depth beyond it from the volume
 /// ([`near_sun_optical_depth`]). Two light cells across: what a cell's
-/// mean extinction cannot show (a cloud's own eroded edge, the crevice
+/// one extinction cannot show (a cloud's own eroded edge, the crevice
 /// beside a turret) lies nearer than that.
 pub const NEAR_SHADOW_M: f32 = 200.0;
 
@@ -238,7 +238,7 @@ pub fn near_step_count(steps: u32, forward: f32) -> u32 {
 /// How much of a primary ray's view is toward the sun, 0 to 1
 /// (`toward_sun` in WGSL): 0 below [`FORWARD_COS_MIN`], 1 from
 /// [`FORWARD_COS_MAX`], smoothly between; [`forward_step_factor`] is
-/// `1 + FORWARD_STEP_BOOST` times it.
+/// `1 + FORWARD_STEP_BOOST · toward_sun`.
 #[inline]
 pub fn toward_sun(cos_theta: f32) -> f32 {
     smoothstep(FORWARD_COS_MIN, FORWARD_COS_MAX, cos_theta)
