@@ -1,6 +1,12 @@
 //! Light: phase functions, sun transmittance by a secondary march,
 //! multiple-scattering octaves and the energy-conserving step
 //! (docs/renderer.md, "Light").
+//!
+//! Over 600 lines: the shadow march (`ShadowSteps` to
+//! `near_sun_optical_depth`) is a module of its own in waiting; it stays
+//! here because `shaders/lighting.wgsl` mirrors this file function for
+//! function (`tests/shader_twins.rs`), and splitting both is a change of
+//! its own.
 
 use std::f32::consts::PI;
 

@@ -12,6 +12,10 @@
 //! which the cloud pass reads with three filtered fetches per lit sample
 //! (bind group 2). It exists only with multiple scattering on
 //! (`render.octaves > 0`) and photons to trace (`render.light_photons`).
+//!
+//! Over 600 lines by one: the pass, its buffers, its bind groups and its
+//! readbacks for the tests are one owner's; the progressive build is
+//! already apart (`light_volume_progressive.rs`).
 
 use bytemuck::{Pod, Zeroable};
 
