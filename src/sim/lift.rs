@@ -237,71 +237,144 @@ pub struct Profile {
     pub rk4_steps: usize,
 }
 
-/// Lifts the sounding's lowest level through all its levels.
-pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
-    let lv = s.levels();
-    let p_of = |i: usize| lv[i].pressure_pa.unwrap_or(f64::NAN);
-    let (t0, q0, p0) = (lv[0].temperature_k, lv[0].mixing_ratio, p_of(0));
-    let q0v = q0.min(saturation_mixing_ratio(t0, p0));
-    let lcl = lcl(t0, q0v, p0);
-    let lcl_height_m = (1..lv.len())
-        .find(|&i| p_of(i) <= lcl.pressure_pa)
-        .map(|i| {
-            let (pa, pb) = (p_of(i - 1), p_of(i));
-            let f = ((lcl.pressure_pa.ln() - pa.ln()) / (pb.ln() - pa.ln())).clamp(0.0, 1.0);
-            lv[i - 1].height_m + f * (lv[i].height_m - lv[i - 1].height_m)
-        });
-    let lcl_height_m = if lcl.pressure_pa >= p0 {
-        Some(lv[0].height_m)
-    } else {
-        lcl_height_m
-    };
+/// The parcel's state at one pressure level of [`lift_parcel`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LiftedLevel {
+    /// Temperature, K.
+    pub t_k: f64,
+    /// Vapour mixing ratio, kg/kg.
+    pub qv: f64,
+    /// Condensate carried, kg/kg (0 on the pseudo-adiabat).
+    pub qc: f64,
+}
+
+/// Air lifted without mixing through given pressures: its LCL and its
+/// state at each pressure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiftedParcel {
+    pub lcl: Lcl,
+    /// One per pressure asked, in the same order.
+    pub levels: Vec<LiftedLevel>,
+    /// RK4 steps taken along the pseudo-adiabat (see [`Profile::rk4_steps`]).
+    pub rk4_steps: usize,
+}
+
+/// Lifts air at `t0_k`, vapour mixing ratio `qv0` (capped at saturation)
+/// and `p0_pa` without mixing through `pressures_pa` (MetPy's
+/// `parcel_profile` with the air's mixing ratio in place of its dewpoint):
+/// the unsaturated adiabat of the moist air up to the LCL, then the moist
+/// adiabat `adiabat`. Pressures may come in any order; the reversible
+/// adiabat is solved from the previous level's temperature, so falling
+/// pressures are the fast order.
+pub fn lift_parcel(
+    t0_k: f64,
+    qv0: f64,
+    p0_pa: f64,
+    pressures_pa: &[f64],
+    adiabat: Adiabat,
+) -> LiftedParcel {
+    let q0v = qv0.min(saturation_mixing_ratio(t0_k, p0_pa));
+    let lcl = lcl(t0_k, q0v, p0_pa);
     // Reversible: the total water and the moist entropy of the air at its
     // LCL are conserved above it.
-    let s_lcl = saturated_entropy(lcl.temperature_k, lcl.pressure_pa, q0);
+    let s_lcl = saturated_entropy(lcl.temperature_k, lcl.pressure_pa, qv0);
     let mut t_rev = lcl.temperature_k;
     // The pseudo-adiabat is integrated once from the LCL to the top level
     // in RK4 steps of PSEUDO_STEP_PA; each level then reads it by cubic
     // Hermite interpolation (the slope is the lapse rate itself), so the
     // work grows with the pressure span, not with levels times span.
-    let top = (0..lv.len()).map(p_of).fold(lcl.pressure_pa, f64::min);
-    let nodes = PseudoNodes::integrate(lcl.temperature_k, lcl.pressure_pa, top);
-    let rows = lv
+    let top = pressures_pa.iter().copied().fold(lcl.pressure_pa, f64::min);
+    let nodes = match adiabat {
+        Adiabat::Pseudo => PseudoNodes::integrate(lcl.temperature_k, lcl.pressure_pa, top),
+        Adiabat::Reversible => {
+            PseudoNodes::integrate(lcl.temperature_k, lcl.pressure_pa, lcl.pressure_pa)
+        }
+    };
+    let kappa = moist_air_kappa(q0v);
+    let levels = pressures_pa
         .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            let p = p_of(i);
-            let (t, qv, qc) = if p >= lcl.pressure_pa {
+        .map(|&p| {
+            if p >= lcl.pressure_pa {
                 // The unsaturated adiabat of the moist air (Romps 2017), the
                 // same one the LCL lies on, so the profile is continuous
                 // there. (MetPy's parcel_profile uses the dry κ here and so
                 // starts its moist adiabat ~0.1 K colder than its own LCL.)
-                (t0 * (p / p0).powf(moist_air_kappa(q0v)), q0v, 0.0)
+                LiftedLevel {
+                    t_k: t0_k * (p / p0_pa).powf(kappa),
+                    qv: q0v,
+                    qc: 0.0,
+                }
             } else {
                 match adiabat {
                     Adiabat::Pseudo => {
                         let t = nodes.at(p);
-                        (t, saturation_mixing_ratio(t, p), 0.0)
+                        LiftedLevel {
+                            t_k: t,
+                            qv: saturation_mixing_ratio(t, p),
+                            qc: 0.0,
+                        }
                     }
                     Adiabat::Reversible => {
-                        t_rev = reversible_temperature(s_lcl, q0, p, t_rev);
-                        let qv = saturation_mixing_ratio(t_rev, p).min(q0);
-                        (t_rev, qv, q0 - qv)
+                        t_rev = reversible_temperature(s_lcl, qv0, p, t_rev);
+                        let qv = saturation_mixing_ratio(t_rev, p).min(qv0);
+                        LiftedLevel {
+                            t_k: t_rev,
+                            qv,
+                            qc: qv0 - qv,
+                        }
                     }
                 }
-            };
+            }
+        })
+        .collect();
+    LiftedParcel {
+        lcl,
+        levels,
+        rk4_steps: nodes.p.len().saturating_sub(1),
+    }
+}
+
+/// Lifts the sounding's lowest level through all its levels.
+pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
+    let lv = s.levels();
+    let p_of = |i: usize| lv[i].pressure_pa.unwrap_or(f64::NAN);
+    let pressures: Vec<f64> = (0..lv.len()).map(p_of).collect();
+    let lifted = lift_parcel(
+        lv[0].temperature_k,
+        lv[0].mixing_ratio,
+        pressures[0],
+        &pressures,
+        adiabat,
+    );
+    let lcl = lifted.lcl;
+    let lcl_height_m = if lcl.pressure_pa >= pressures[0] {
+        Some(lv[0].height_m)
+    } else {
+        (1..lv.len())
+            .find(|&i| pressures[i] <= lcl.pressure_pa)
+            .map(|i| {
+                let (pa, pb) = (pressures[i - 1], pressures[i]);
+                let f = ((lcl.pressure_pa.ln() - pa.ln()) / (pb.ln() - pa.ln())).clamp(0.0, 1.0);
+                lv[i - 1].height_m + f * (lv[i].height_m - lv[i - 1].height_m)
+            })
+    };
+    let rows = lv
+        .iter()
+        .zip(&pressures)
+        .zip(&lifted.levels)
+        .map(|((l, &p), a)| {
             let qs_env = saturation_mixing_ratio(l.temperature_k, p);
             let env_qv = l.mixing_ratio.min(qs_env);
             let env_qc = l.mixing_ratio - env_qv;
             let tv_env = l.temperature_k * (1.0 + VIRTUAL_COEFF * env_qv - env_qc);
-            let tv = t * (1.0 + VIRTUAL_COEFF * qv - qc);
+            let tv = a.t_k * (1.0 + VIRTUAL_COEFF * a.qv - a.qc);
             ProfileRow {
                 height_m: l.height_m,
                 pressure_pa: p,
                 env_t_k: l.temperature_k,
-                parcel_t_k: t,
-                parcel_qv: qv,
-                parcel_qc: qc,
+                parcel_t_k: a.t_k,
+                parcel_qv: a.qv,
+                parcel_qc: a.qc,
                 buoyancy: G * (tv - tv_env) / tv_env,
             }
         })
@@ -310,7 +383,7 @@ pub fn lift_sounding(s: &Sounding, adiabat: Adiabat) -> Profile {
         lcl,
         lcl_height_m,
         rows,
-        rk4_steps: nodes.p.len().saturating_sub(1),
+        rk4_steps: lifted.rk4_steps,
     }
 }
 
@@ -328,6 +401,41 @@ pub fn surface_lcl_height(atm: &Atmosphere) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `lift_parcel` (what the Python package's `parcel_profile` calls)
+    /// answers each pressure alone: any order gives the same state, and
+    /// the levels of a sounding give `lift_sounding`'s rows.
+    #[test]
+    fn a_lifted_parcel_does_not_depend_on_the_order_of_its_pressures() {
+        let falling: Vec<f64> = (0..60).map(|i| 101_000.0 - 1_500.0 * i as f64).collect();
+        let mut shuffled = falling.clone();
+        shuffled.reverse();
+        shuffled.rotate_left(17);
+        for how in [Adiabat::Pseudo, Adiabat::Reversible] {
+            let a = lift_parcel(300.0, 0.016, falling[0], &falling, how);
+            let b = lift_parcel(300.0, 0.016, falling[0], &shuffled, how);
+            for (p, lb) in shuffled.iter().zip(&b.levels) {
+                let k = falling.iter().position(|q| q == p).expect("same pressures");
+                let la = a.levels[k];
+                assert!((la.t_k - lb.t_k).abs() < 1e-7, "{how:?} at {p} Pa");
+                assert!((la.qc - lb.qc).abs() < 1e-10, "{how:?} at {p} Pa");
+            }
+        }
+        let s = Sounding::analytic_tropical(41);
+        let prof = lift_sounding(&s, Adiabat::Reversible);
+        let p: Vec<f64> = prof.rows.iter().map(|r| r.pressure_pa).collect();
+        let lv = s.levels()[0];
+        let alone = lift_parcel(
+            lv.temperature_k,
+            lv.mixing_ratio,
+            p[0],
+            &p,
+            Adiabat::Reversible,
+        );
+        for (r, l) in prof.rows.iter().zip(&alone.levels) {
+            assert_eq!(r.parcel_t_k, l.t_k);
+        }
+    }
 
     #[test]
     fn lcl_lies_on_dry_adiabat_and_dewpoint() {
