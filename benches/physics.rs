@@ -4,15 +4,16 @@
 //! 100 km; 100,000: 316 km), the parcels are spun up for 20 minutes first so they are
 //! released, rising and condensing.
 //!
-//! Also `lcl` + the pseudo-adiabatic profile (`lift_sounding`, what
-//! `cumulus profile` computes) of an analytic tropical sounding of 17, 401
-//! and 4,001 levels; `benches/metpy_profile_timing.py` times MetPy's `lcl` +
-//! `parcel_profile` on the same soundings.
+//! Also the LCL and the pseudo-adiabatic parcel of an analytic tropical
+//! sounding of 17, 401 and 4,001 levels: `lift_parcel` (MetPy's work) and
+//! `lift_sounding` (what `cumulus profile` computes, with the
+//! environment and the buoyancy); `benches/metpy_profile_timing.py` times
+//! MetPy's `lcl` + `parcel_profile` on the same soundings.
 //!
 //! `cargo bench --bench physics`
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use cumulus::sim::lift::{Adiabat, lift_sounding};
+use cumulus::sim::lift::{Adiabat, lift_parcel, lift_sounding};
 use cumulus::sim::{
     Atmosphere, Band, ParametricProfile, PhysicsConfig, ProjectedField, Simulation, Sounding,
 };
@@ -108,6 +109,23 @@ fn profile(c: &mut Criterion) {
         let s = Sounding::analytic_tropical(n);
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| lift_sounding(&s, Adiabat::Pseudo))
+        });
+    }
+    g.finish();
+    // MetPy's work alone (`lcl` + `parcel_profile`: the LCL and the
+    // parcel's temperature at each pressure): what the Python package's
+    // `parcel_profile` calls. It also gives the parcel's vapour.
+    let mut g = c.benchmark_group("lcl_and_pseudo_parcel");
+    for n in [17, 401, 4001] {
+        let s = Sounding::analytic_tropical(n);
+        let p: Vec<f64> = s
+            .levels()
+            .iter()
+            .map(|l| l.pressure_pa.unwrap_or(0.0))
+            .collect();
+        let (t0, q0) = (s.levels()[0].temperature_k, s.levels()[0].mixing_ratio);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| lift_parcel(t0, q0, p[0], &p, Adiabat::Pseudo))
         });
     }
     g.finish();

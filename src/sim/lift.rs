@@ -10,7 +10,8 @@ use super::atmosphere::Atmosphere;
 use super::constants::{C_P, EPSILON, G, L_V, R_D, R_V, VIRTUAL_COEFF};
 use super::sounding::Sounding;
 use super::thermo::{
-    dewpoint, latent_heat_at, saturation_mixing_ratio, saturation_vapour_pressure,
+    dewpoint, dln_es_dt, latent_heat_at, ln_saturation_vapour_pressure, saturation_mixing_ratio,
+    saturation_mixing_ratio_and_slope, saturation_vapour_pressure,
 };
 
 /// Which moist adiabat the parcel follows above its LCL.
@@ -49,7 +50,8 @@ pub fn moist_air_kappa(qv: f64) -> f64 {
 /// unsaturated adiabat, `T (p/p_0)^(R_m/c_pm)` with the moist air's own gas
 /// constant and heat capacity, meets the dewpoint of the conserved mixing
 /// ratio. This is the problem Romps (2017) solves in closed form (MetPy's
-/// `lcl` since 1.6); here by bisection to 1e-6 Pa. With the dry `κ` the LCL
+/// `lcl` since 1.6); here by Newton's method in `ln p`, to round-off. With
+/// the dry `κ` the LCL
 /// of hot, humid air is up to 17 m too low. Saturated (or supersaturated)
 /// air is at its LCL.
 pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
@@ -67,20 +69,42 @@ pub fn lcl(t_k: f64, qv: f64, p_pa: f64) -> Lcl {
         };
     }
     let kappa = moist_air_kappa(qv);
-    let gap = |p: f64| t_k * (p / p_pa).powf(kappa) - dewpoint(qv, p).unwrap_or(0.0);
-    let (mut lo, mut hi) = (1.0_f64, p_pa);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if gap(mid) > 0.0 {
-            hi = mid
+    // Where the air's temperature meets its dewpoint, its vapour pressure
+    // e = p q/(ε + q) meets e_s(T). In x = ln p, with ln T = ln T_0 +
+    // κ (x - ln p_0), the gap ln e_s(T) - ln e rises with x (its slope
+    // κ L/(R_v T) - 1 is about 4), positive at the ground and negative
+    // aloft: Newton, kept inside a bracket that bisects when a step
+    // would leave it.
+    let (ln_t0, ln_p0) = (t_k.ln(), p_pa.ln());
+    let ln_share = (qv / (EPSILON + qv)).ln();
+    let gap = |x: f64| {
+        let ln_t = ln_t0 + kappa * (x - ln_p0);
+        let t = ln_t.exp();
+        let g = ln_saturation_vapour_pressure(t, ln_t) - ln_share - x;
+        (g, dln_es_dt(t) * kappa * t - 1.0)
+    };
+    let (mut lo, mut hi) = (0.0_f64, ln_p0);
+    let mut x = ln_p0;
+    for _ in 0..100 {
+        let (g, slope) = gap(x);
+        if g > 0.0 {
+            hi = x
         } else {
-            lo = mid
+            lo = x
         }
-        if hi - lo < 1e-6 {
+        let newton = x - g / slope;
+        let next = if slope > 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        let done = (next - x).abs() < 1e-14 || hi - lo < 1e-14;
+        x = next;
+        if done {
             break;
         }
     }
-    let p = 0.5 * (lo + hi);
+    let p = x.exp();
     Lcl {
         pressure_pa: p,
         temperature_k: t_k * (p / p_pa).powf(kappa),
@@ -155,17 +179,45 @@ fn rk4_steps(p0: f64, p1: f64, max_step_pa: f64) -> usize {
     ((p1 - p0).abs() / max_step_pa).ceil().max(1.0) as usize
 }
 
-/// The pseudo-adiabat tabulated at RK4 nodes `PSEUDO_STEP_PA` apart, with
-/// its lapse rate at each, for cubic Hermite interpolation.
+/// The pseudo-adiabat tabulated at RK4 nodes `PSEUDO_STEP_PA` apart,
+/// with its lapse rate, the saturation mixing ratio and that ratio's rate
+/// of change along the adiabat at each node, for cubic Hermite
+/// interpolation of both.
 struct PseudoNodes {
     /// Falling pressures, Pa.
     p: Vec<f64>,
     t: Vec<f64>,
     dtdp: Vec<f64>,
+    qs: Vec<f64>,
+    /// `dq_s/dp` along the adiabat: `∂q_s/∂T dT/dp + ∂q_s/∂p`, 1/Pa.
+    dqsdp: Vec<f64>,
+}
+
+/// A node's lapse rate (as [`pseudo_lapse`]), saturation mixing ratio and
+/// that ratio's rate of change along the adiabat, with
+/// `∂q_s/∂p = -q_s (ε + q_s) / (ε p)` at fixed T.
+fn node_rates(t: f64, p: f64) -> (f64, f64, f64) {
+    let (qs, dqs_dt) = saturation_mixing_ratio_and_slope(t, p);
+    let dtdp = (R_D * t + L_V * qs) / (C_P + L_V * L_V * qs * EPSILON / (R_D * t * t)) / p;
+    let dqs_dp_at_t = -qs * (EPSILON + qs) / (EPSILON * p);
+    (dtdp, qs, dqs_dt * dtdp + dqs_dp_at_t)
+}
+
+/// The cubic Hermite basis at `s` in 0..=1: the weights of the two ends'
+/// values and slopes (slopes per unit `s`).
+fn hermite(s: f64) -> [f64; 4] {
+    let (s2, s3) = (s * s, s * s * s);
+    [
+        2.0 * s3 - 3.0 * s2 + 1.0,
+        s3 - 2.0 * s2 + s,
+        -2.0 * s3 + 3.0 * s2,
+        s3 - s2,
+    ]
 }
 
 impl PseudoNodes {
-    /// From `(t0, p0)` up to `p_top` (< `p0`; none when not).
+    /// From `(t0, p0)` up to `p_top` (< `p0`; none when not): one RK4 step
+    /// from node to node, its first stage the node's own lapse rate.
     fn integrate(t0: f64, p0: f64, p_top: f64) -> Self {
         let n = if p_top < p0 {
             rk4_steps(p0, p_top, PSEUDO_STEP_PA)
@@ -177,36 +229,59 @@ impl PseudoNodes {
             p: Vec::with_capacity(n + 1),
             t: Vec::with_capacity(n + 1),
             dtdp: Vec::with_capacity(n + 1),
+            qs: Vec::with_capacity(n + 1),
+            dqsdp: Vec::with_capacity(n + 1),
         };
         let (mut t, mut p) = (t0, p0);
         for k in 0..=n {
+            let (k1, qs, dqsdp) = node_rates(t, p);
             nodes.p.push(p);
             nodes.t.push(t);
-            nodes.dtdp.push(pseudo_lapse(t, p));
+            nodes.dtdp.push(k1);
+            nodes.qs.push(qs);
+            nodes.dqsdp.push(dqsdp);
             if k < n {
-                t = pseudo_adiabat_with_step(t, p, p + dp, PSEUDO_STEP_PA);
+                let k2 = pseudo_lapse(t + 0.5 * dp * k1, p + 0.5 * dp);
+                let k3 = pseudo_lapse(t + 0.5 * dp * k2, p + 0.5 * dp);
+                let k4 = pseudo_lapse(t + dp * k3, p + dp);
+                t += dp / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
                 p = p0 + (k + 1) as f64 * dp;
             }
         }
         nodes
     }
 
-    /// The temperature at `p` (between the first and last node).
-    fn at(&self, p: f64) -> f64 {
+    /// The temperature and saturation mixing ratio at `p` (clamped to the
+    /// nodes' span). `cursor` is the interval the previous call used:
+    /// levels in falling order find theirs without a search.
+    fn at(&self, p: f64, cursor: &mut usize) -> (f64, f64) {
         let n = self.p.len();
         if n < 2 {
-            return self.t.first().copied().unwrap_or(f64::NAN);
+            let t = self.t.first().copied().unwrap_or(f64::NAN);
+            let q = self.qs.first().copied().unwrap_or(f64::NAN);
+            return (t, q);
         }
-        // The interval whose nodes straddle p (pressures fall).
-        let k = self.p.partition_point(|&q| q > p).clamp(1, n - 1) - 1;
+        // The interval whose nodes straddle p (pressures fall): the
+        // previous one, the next, or a binary search.
+        let within = |k: usize| k + 1 < n && self.p[k] >= p && p >= self.p[k + 1];
+        let k = if within(*cursor) {
+            *cursor
+        } else if within(*cursor + 1) {
+            *cursor + 1
+        } else {
+            self.p.partition_point(|&q| q > p).clamp(1, n - 1) - 1
+        };
+        *cursor = k;
         let (p0, p1) = (self.p[k], self.p[k + 1]);
         let h = p1 - p0;
-        let s = ((p - p0) / h).clamp(0.0, 1.0);
-        let (s2, s3) = (s * s, s * s * s);
-        (2.0 * s3 - 3.0 * s2 + 1.0) * self.t[k]
-            + (s3 - 2.0 * s2 + s) * h * self.dtdp[k]
-            + (-2.0 * s3 + 3.0 * s2) * self.t[k + 1]
-            + (s3 - s2) * h * self.dtdp[k + 1]
+        let [a0, b0, a1, b1] = hermite(((p - p0) / h).clamp(0.0, 1.0));
+        let t =
+            a0 * self.t[k] + b0 * h * self.dtdp[k] + a1 * self.t[k + 1] + b1 * h * self.dtdp[k + 1];
+        let q = a0 * self.qs[k]
+            + b0 * h * self.dqsdp[k]
+            + a1 * self.qs[k + 1]
+            + b1 * h * self.dqsdp[k + 1];
+        (t, q)
     }
 }
 
@@ -291,6 +366,7 @@ pub fn lift_parcel(
         }
     };
     let kappa = moist_air_kappa(q0v);
+    let mut cursor = 0;
     let levels = pressures_pa
         .iter()
         .map(|&p| {
@@ -307,10 +383,10 @@ pub fn lift_parcel(
             } else {
                 match adiabat {
                     Adiabat::Pseudo => {
-                        let t = nodes.at(p);
+                        let (t, qv) = nodes.at(p, &mut cursor);
                         LiftedLevel {
                             t_k: t,
-                            qv: saturation_mixing_ratio(t, p),
+                            qv,
                             qc: 0.0,
                         }
                     }
@@ -401,6 +477,38 @@ pub fn surface_lcl_height(atm: &Atmosphere) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The vapour a pseudo-adiabatic level reports is the nodes' Hermite
+    /// interpolation of `q_s`: the saturation mixing ratio of the level's
+    /// own temperature and pressure to within 2e-9 kg/kg (a fifth of the
+    /// last digit `cumulus profile` prints; measured 1.05e-9) and 1e-4 of
+    /// itself (the relative error grows where `q_s` is a few mg/kg, near
+    /// 100 hPa; measured 7.5e-5).
+    #[test]
+    fn the_interpolated_vapour_is_the_levels_saturation() {
+        let s = Sounding::analytic_tropical(4001);
+        let p: Vec<f64> = s
+            .levels()
+            .iter()
+            .map(|l| l.pressure_pa.unwrap_or(0.0))
+            .collect();
+        let lv = s.levels()[0];
+        let lifted = lift_parcel(lv.temperature_k, lv.mixing_ratio, p[0], &p, Adiabat::Pseudo);
+        let (mut worst, mut worst_rel) = (0.0_f64, 0.0_f64);
+        let mut above = 0;
+        for (&pk, l) in p.iter().zip(&lifted.levels) {
+            if pk < lifted.lcl.pressure_pa {
+                let qs = saturation_mixing_ratio(l.t_k, pk);
+                worst = worst.max((l.qv - qs).abs());
+                worst_rel = worst_rel.max((l.qv - qs).abs() / qs);
+                above += 1;
+            }
+        }
+        eprintln!("interpolated q_s: worst {worst:e} kg/kg, {worst_rel:e} relative");
+        assert!(above > 3000, "{above} levels above the LCL");
+        assert!(worst < 2e-9, "{worst:e} kg/kg");
+        assert!(worst_rel < 1e-4, "relative error {worst_rel:e}");
+    }
 
     /// `lift_parcel` (what the Python package's `parcel_profile` calls)
     /// answers each pressure alone: any order gives the same state, and

@@ -61,7 +61,7 @@ pub fn saturation_vapour_pressure(t_k: f64) -> f64 {
 /// `ln e_s(T)` from `T` and `ln T` (Ambaum's form as one sum of logs, so a
 /// caller that has `ln T` pays one `exp` for `e_s`, no `powf`).
 #[inline]
-fn ln_saturation_vapour_pressure(t: f64, ln_t: f64) -> f64 {
+pub(crate) fn ln_saturation_vapour_pressure(t: f64, ln_t: f64) -> f64 {
     use ambaum::*;
     E0_PA.ln()
         + (CP_L - CP_V) / R_V * (T0_K.ln() - ln_t)
@@ -71,7 +71,7 @@ fn ln_saturation_vapour_pressure(t: f64, ln_t: f64) -> f64 {
 /// `d ln e_s / dT = L(T) / (R_v T²)`, 1/K: Clausius-Clapeyron holds exactly
 /// for Ambaum's form.
 #[inline]
-fn dln_es_dt(t_k: f64) -> f64 {
+pub(crate) fn dln_es_dt(t_k: f64) -> f64 {
     latent_heat_at(t_k) / (ambaum::R_V * t_k * t_k)
 }
 
