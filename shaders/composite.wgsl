@@ -85,5 +85,6 @@ fn sky_background(pos: vec2f) -> vec3f {
     // The clouds the sea mirrors are in the cloud layer (the cloud pass's
     // sea_reflection_change, accumulated by TSAA): the sea here is bare.
     let land = flat_ground_albedo(eye, dir, frame.cam_pos.w);
-    return background_radiance(dir, sun_dir, sea_waves_at(eye, dir), flat_ground_shadow(eye, dir, sun_dir), land, vec4f(0.0, 0.0, 0.0, 1.0));
+    let bg = background_radiance(dir, sun_dir, sea_waves_at(eye, dir), flat_ground_shadow(eye, dir, sun_dir), land, vec4f(0.0, 0.0, 0.0, 1.0));
+    return cirrus_over(eye, dir, sun_dir, frame.cam_pos.w, bg);
 }

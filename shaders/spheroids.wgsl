@@ -241,6 +241,6 @@ fn fs_spheroids(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let c = march_spheroids(frame.cam_pos.xyz, dir, standalone_dither(px.x, px.y));
     // No cloud shadows on its ground and no clouds in its sea: its bind
     // groups have no P or map.
-    let bg = background_radiance(dir, frame.sun_dir.xyz, sea_waves_at(frame.cam_pos.xyz, dir), 1.0, flat_ground_albedo(frame.cam_pos.xyz, dir, frame.cam_pos.w), vec4f(0.0, 0.0, 0.0, 1.0));
+    let bg = cirrus_over(frame.cam_pos.xyz, dir, frame.sun_dir.xyz, frame.cam_pos.w, background_radiance(dir, frame.sun_dir.xyz, sea_waves_at(frame.cam_pos.xyz, dir), 1.0, flat_ground_albedo(frame.cam_pos.xyz, dir, frame.cam_pos.w), vec4f(0.0, 0.0, 0.0, 1.0)));
     return vec4f(display(c.rgb + (1.0 - c.a) * bg, pos.xy), 1.0);
 }

@@ -117,6 +117,6 @@ fn fs_volume(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let px = vec2u(pos.xy);
     let dir = camera_ray(pos.xy);
     let c = march_volume(frame.cam_pos.xyz, dir, standalone_dither(px.x, px.y));
-    let bg = background_radiance(dir, frame.sun_dir.xyz, sea_waves_at(frame.cam_pos.xyz, dir), 1.0, flat_ground_albedo(frame.cam_pos.xyz, dir, frame.cam_pos.w), vec4f(0.0, 0.0, 0.0, 1.0));
+    let bg = cirrus_over(frame.cam_pos.xyz, dir, frame.sun_dir.xyz, frame.cam_pos.w, background_radiance(dir, frame.sun_dir.xyz, sea_waves_at(frame.cam_pos.xyz, dir), 1.0, flat_ground_albedo(frame.cam_pos.xyz, dir, frame.cam_pos.w), vec4f(0.0, 0.0, 0.0, 1.0)));
     return vec4f(display(c.rgb + (1.0 - c.a) * bg, pos.xy), 1.0);
 }

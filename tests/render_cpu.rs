@@ -445,6 +445,7 @@ fn constant_slab_transmittance_matches_beer_lambert() {
                 ..AtmosphereConfig::default()
             },
             single_scattering: false,
+            cirrus: None,
         },
         terrain: None,
         sky: None,
@@ -520,6 +521,7 @@ fn small_frame<'a>(p: &'a ProjectedField, cm: &'a CloudMap) -> Frame<'a> {
                 ..AtmosphereConfig::default()
             },
             single_scattering: false,
+            cirrus: None,
         },
         terrain: None,
         sky: None,

@@ -151,6 +151,53 @@ fn gpu_matches_cpu_reference_from_the_ground() {
     );
 }
 
+/// The cirrus layer (`[render.cirrus]`) in a sky looking up: the
+/// composite's `cirrus_over` against the CPU's, and a layer that is there
+/// (the sky above the clouds differs from the same view without it) and
+/// costs nothing when off (its override constant false).
+#[test]
+fn gpu_matches_cpu_reference_under_cirrus() {
+    let Some(ctx) = gpu() else { return };
+    let mut sc = scene("fair_weather");
+    sc.render.camera_pitch_deg = 30.0;
+    assert_eq!(
+        sc.render.quality().cirrus,
+        None,
+        "a scene without [render.cirrus] draws no layer"
+    );
+    let off = sc.render.clone();
+    sc.render.cirrus.cover = 0.6;
+    parity_96x64(&ctx, &sc);
+    let prepared = Prepared::from_scene(&sc, || {}).expect("prepare");
+    let on = RenderSettings {
+        width: 96,
+        height: 64,
+        ..sc.render.clone()
+    };
+    let off = RenderSettings {
+        width: 96,
+        height: 64,
+        ..off
+    };
+    let flag = |r: &RenderSettings| {
+        prepared
+            .gpu_settings(r, r.quality())
+            .constants()
+            .into_iter()
+            .find(|(n, _)| *n == "CIRRUS")
+            .map(|(_, v)| v)
+    };
+    assert_eq!(flag(&off), Some(0.0));
+    assert_eq!(flag(&on), Some(1.0));
+    let sky = |r: &RenderSettings| {
+        let px = still_srgb8(96, 64, &prepared.frame(r, r.quality()), 1);
+        // The top ten rows: sky above the band.
+        px[..96 * 10 * 3].to_vec()
+    };
+    let (mean, _) = diff(&sky(&on), &sky(&off));
+    assert!(mean > 0.01, "the layer changes the sky by {mean}");
+}
+
 /// The sea (BOMEX's ground) with the sun's glint, the reflected sky and
 /// the horizon in view: the composite's `background_radiance` and the
 /// cloud pass's `sea_reflection_change` against the CPU's.

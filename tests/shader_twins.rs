@@ -14,7 +14,7 @@ use std::path::Path;
 
 use cumulus::render::cpu::spheroids::{self, Spheroid};
 use cumulus::render::cpu::{
-    density, frame, glare, land, light_grid, light_transport, lighting, renderer, sea, sky,
+    cirrus, density, frame, glare, land, light_grid, light_transport, lighting, renderer, sea, sky,
     sky_luts, waves,
 };
 use cumulus::render::gpu::light_volume_pass::{self, LightVolumeGridUniforms};
@@ -86,6 +86,14 @@ fn rust_constants() -> Vec<(&'static str, f64)> {
             "VOLUME_SHADOW_RAY_M",
             cumulus::render::cpu::volume::VOLUME_SHADOW_RAY_M as f64,
         ),
+        ("CIRRUS_ALONG_M", cirrus::CIRRUS_ALONG_M as f64),
+        ("CIRRUS_ACROSS_M", cirrus::CIRRUS_ACROSS_M as f64),
+        ("CIRRUS_OCTAVES", cirrus::CIRRUS_OCTAVES as f64),
+        ("CIRRUS_FIBRE_GROWTH", cirrus::CIRRUS_FIBRE_GROWTH as f64),
+        ("CIRRUS_CONTRAST", cirrus::CIRRUS_CONTRAST as f64),
+        ("CIRRUS_EDGE", cirrus::CIRRUS_EDGE as f64),
+        ("CIRRUS_PHASE_G", cirrus::CIRRUS_PHASE_G as f64),
+        ("CIRRUS_MU_MIN", cirrus::CIRRUS_MU_MIN as f64),
         ("FIELD_LENGTH_M", land::FIELD_LENGTH_M as f64),
         ("FIELD_WIDTH_M", land::FIELD_WIDTH_M as f64),
         ("FIELD_ANGLE", land::FIELD_ANGLE as f64),
@@ -462,6 +470,7 @@ const MIRRORS: &[(&str, &[&str])] = &[
     ("density.wgsl", &["src/render/cpu/density.rs"]),
     ("lighting.wgsl", &["src/render/cpu/lighting.rs"]),
     ("sky.wgsl", &["src/render/cpu/sky.rs"]),
+    ("cirrus.wgsl", &["src/render/cpu/cirrus.rs"]),
     ("sky_analytic.wgsl", &["src/render/cpu/sky.rs"]),
     ("sky_physical.wgsl", &["src/render/cpu/sky.rs"]),
     ("waves.wgsl", &["src/render/cpu/waves.rs"]),

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::render::camera::Camera;
 use crate::render::cloud_map::CloudMapConfig;
+use crate::render::cpu::cirrus::CirrusLayer;
 use crate::render::cpu::density::DensityParams;
 use crate::render::cpu::exposure::auto_exposure_factor;
 use crate::render::cpu::frame::Quality;
@@ -165,6 +166,9 @@ pub struct RenderSettings {
     /// The sky model and aerial perspective (`[render.atmosphere]`):
     /// physical by default.
     pub atmosphere: AtmosphereConfig,
+    /// The cirrus layer above the clouds (`[render.cirrus]`): none by
+    /// default (`cover = 0`).
+    pub cirrus: CirrusLayer,
 }
 
 impl Default for RenderSettings {
@@ -202,6 +206,7 @@ impl Default for RenderSettings {
             terrain: TerrainConfig::default(),
             ground: GroundConfig::default(),
             atmosphere: AtmosphereConfig::default(),
+            cirrus: CirrusLayer::default(),
         }
     }
 }
@@ -403,6 +408,28 @@ impl RenderSettings {
                 3.0,
                 "0..=3",
             ),
+            range("render.cirrus.cover", f(r.cirrus.cover), 0.0, 1.0, "0..=1"),
+            range(
+                "render.cirrus.altitude_m",
+                f(r.cirrus.altitude_m),
+                4000.0,
+                15000.0,
+                "4000..=15000 m",
+            ),
+            range(
+                "render.cirrus.direction_deg",
+                f(r.cirrus.direction_deg),
+                -360.0,
+                360.0,
+                "-360..=360 degrees",
+            ),
+            range(
+                "render.cirrus.optical_depth",
+                f(r.cirrus.optical_depth),
+                0.0,
+                3.0,
+                "0..=3",
+            ),
             range(
                 "render.ground.wind_speed_mps",
                 f(r.ground.wind_speed_mps),
@@ -510,6 +537,7 @@ impl RenderSettings {
             sea_time_s: self.time_s as f32,
             land_fields: self.ground.land_fields(),
             atmosphere: self.atmosphere,
+            cirrus: self.cirrus.drawn(),
             single_scattering: false,
         }
     }

@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 
+use super::cirrus::CirrusLayer;
 use super::density::{DensityParams, Fields};
 use super::light_volume::LightVolume;
 use super::lighting::LightGains;
@@ -52,6 +53,9 @@ pub struct Quality {
     pub land_fields: bool,
     /// The sky model and aerial perspective (`[render.atmosphere]`).
     pub atmosphere: AtmosphereConfig,
+    /// The cirrus layer above the clouds (`[render.cirrus]`;
+    /// [`super::cirrus`]), when drawn.
+    pub cirrus: Option<CirrusLayer>,
     /// Only the sun's light scattered once: no octaves, no sky or ground
     /// light in the clouds, nothing behind them (black) and no haze in
     /// front; what a path tracer limited to one scattering renders

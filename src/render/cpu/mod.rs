@@ -8,6 +8,7 @@
 //! `map_extent_m` and repeat to the horizon, looked up through a
 //! non-periodic warp outside the simulated domain (`density::domain_warp`).
 
+pub mod cirrus;
 pub mod density;
 pub mod density_grid;
 pub mod exposure;

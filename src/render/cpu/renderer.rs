@@ -7,6 +7,7 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::cirrus::cirrus_over;
 use super::density::{band_segment, density_at};
 use super::frame::{Frame, MIN_TRANSMITTANCE, diffused_light};
 use super::land::{flat_ground_albedo, terrain_albedo};
@@ -112,8 +113,8 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
             terrain_radiance(origin + dir * t, t, dir, sun_dir, spread, h, fr),
             t,
         ),
-        None => (
-            background_radiance(
+        None => {
+            let bg = background_radiance(
                 sky,
                 dir,
                 sun_dir,
@@ -121,9 +122,16 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
                 flat_ground_shadow(origin, dir, sun_dir, fr),
                 flat_ground_albedo(origin, dir, spread, fr),
                 (Vec3::ZERO, 1.0),
-            ) + sea_reflection_change(origin, dir, dither, sun_dir, spread, fr),
-            q.max_distance_m,
-        ),
+            );
+            let bg = match &q.cirrus {
+                Some(layer) => cirrus_over(sky, origin, dir, sun_dir, spread, layer, bg),
+                None => bg,
+            };
+            (
+                bg + sea_reflection_change(origin, dir, dither, sun_dir, spread, fr),
+                q.max_distance_m,
+            )
+        }
     };
     let background = if q.single_scattering {
         Vec3::ZERO

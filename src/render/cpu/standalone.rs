@@ -8,6 +8,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::cirrus::cirrus_over;
 use super::frame::{Frame, MIN_TRANSMITTANCE};
 use super::land::flat_ground_albedo;
 use super::lighting::{ALBEDO, LightGains, ambient_light, integrate_step, sun_scattering};
@@ -175,6 +176,10 @@ pub fn render_standalone(
                     flat_ground_albedo(fr.view.eye(), dir, spread, fr),
                     (Vec3::ZERO, 1.0),
                 );
+                let bg = match &fr.quality.cirrus {
+                    Some(layer) => cirrus_over(sky, fr.view.eye(), dir, sun_dir, spread, layer, bg),
+                    None => bg,
+                };
                 *px = c.truncate() + (1.0 - c.w) * bg;
             }
         });

@@ -68,6 +68,7 @@ impl GpuSettings {
     /// that is off is compiled out.
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let cirrus = self.quality.cirrus;
         vec![
             ("SHADOW_STEPS", self.quality.shadow_steps as f64),
             ("OCTAVES", self.quality.octaves as f64),
@@ -88,6 +89,20 @@ impl GpuSettings {
             (
                 "SEA_WIND_TOWARD_DEG",
                 self.quality.sea_wind_toward_deg as f64,
+            ),
+            ("CIRRUS", flag(cirrus.is_some())),
+            ("CIRRUS_COVER", cirrus.map_or(0.0, |c| c.cover as f64)),
+            (
+                "CIRRUS_ALTITUDE_M",
+                cirrus.map_or(9000.0, |c| c.altitude_m as f64),
+            ),
+            (
+                "CIRRUS_DIRECTION_DEG",
+                cirrus.map_or(60.0, |c| c.direction_deg as f64),
+            ),
+            (
+                "CIRRUS_OPTICAL_DEPTH",
+                cirrus.map_or(0.2, |c| c.optical_depth as f64),
             ),
         ]
     }

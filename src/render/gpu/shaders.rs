@@ -10,7 +10,7 @@
 
 /// The shared functions of every pass: the frame's values and bindings,
 /// then the twins of `render::camera` and of `render::cpu`'s `density`,
-/// `lighting`, `sky`, `waves`, `sea`, `tone_map` and `renderer`.
+/// `lighting`, `sky`, `cirrus`, `waves`, `sea`, `tone_map` and `renderer`.
 pub const CLOUDS: &str = concat!(
     include_str!("../../../shaders/frame.wgsl"),
     "\n",
@@ -21,6 +21,8 @@ pub const CLOUDS: &str = concat!(
     include_str!("../../../shaders/lighting.wgsl"),
     "\n",
     include_str!("../../../shaders/sky.wgsl"),
+    "\n",
+    include_str!("../../../shaders/cirrus.wgsl"),
     "\n",
     include_str!("../../../shaders/waves.wgsl"),
     "\n",
