@@ -22,19 +22,19 @@ use cumulus::sim::{
 };
 
 create_exception!(
-    _native,
+    cumulus,
     CumulusError,
     PyException,
     "Every error cumulus raises."
 );
 create_exception!(
-    _native,
+    cumulus,
     SoundingError,
     CumulusError,
     "A sounding that cannot be read: the message names the file and line."
 );
 create_exception!(
-    _native,
+    cumulus,
     SceneError,
     CumulusError,
     "A scene that cannot be read or run: the message names the file, line and key."

@@ -99,6 +99,8 @@ def test_library_errors_carry_the_command_lines_messages(tmp_path):
         cumulus.simulate("no_such_scene", 10.0)
     assert issubclass(cumulus.SoundingError, cumulus.CumulusError)
     assert issubclass(cumulus.SceneError, cumulus.CumulusError)
+    # Tracebacks name them as the package exports them.
+    assert cumulus.SceneError.__module__ == "cumulus"
 
 
 def test_simulate_returns_the_parcel_curves_columns():
