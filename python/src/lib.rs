@@ -324,7 +324,6 @@ fn simulate<'py>(
     let band = sc.band(&atm);
     let plan = FramePlan::new(duration_s, sc.physics.dt_s);
     let every = every_s.unwrap_or(sc.physics.dt_s);
-    let write_every = (every / sc.physics.dt_s).round().max(1.0) as u64;
     let frames = plan.frames();
     let mut sim = Simulation::new(sc.physics.clone(), atm);
     let mut out = Records::new();
@@ -332,7 +331,7 @@ fn simulate<'py>(
     for f in 1..=frames {
         let dt = plan.frame_s(f - 1);
         py.detach(|| sim.advance(dt));
-        if f % write_every == 0 || f == frames {
+        if plan.records_after(f, every) {
             out.push(&sim, band);
         }
         // Ctrl-C stops the run with KeyboardInterrupt.

@@ -58,6 +58,14 @@ impl FramePlan {
             self.last_s
         }
     }
+
+    /// Whether the state after frame `f` (1-based) is recorded when
+    /// records are taken every `every_s` simulated seconds: every
+    /// `every_s / dt_s` frames (rounded, at least 1), and the last frame.
+    pub fn records_after(&self, f: u64, every_s: f64) -> bool {
+        let stride = (every_s / self.dt_s).round().max(1.0) as u64;
+        f.is_multiple_of(stride) || f == self.frames()
+    }
 }
 
 /// Above this many parcels the per-parcel update runs on all cores.

@@ -81,7 +81,6 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     // divide it.
     let plan = FramePlan::new(a.duration_s, scene.physics.dt_s);
     let frames = plan.frames();
-    let write_every = (every / scene.physics.dt_s).round().max(1.0) as u64;
     let mut sim = Simulation::new(scene.physics.clone(), atm);
     let bar = progress_bar(frames, "simulating");
     write_atomically(&a.out, |out| {
@@ -90,7 +89,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         curves::write_rows(&mut w, &sim, band)?;
         for f in 1..=frames {
             sim.advance(plan.frame_s(f - 1));
-            if f % write_every == 0 || f == frames {
+            if plan.records_after(f, every) {
                 curves::write_rows(&mut w, &sim, band)?;
             }
             bar.inc(1);

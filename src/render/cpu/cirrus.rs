@@ -78,7 +78,9 @@ pub const CIRRUS_PHASE_G: f32 = 0.75;
 pub const CIRRUS_MU_MIN: f32 = 0.03;
 
 /// An integer hash of the lattice point `(ix, iy)` to `[0, 1)` (PCG's
-/// output permutation): the same bits on the CPU and the GPU.
+/// output permutation): the same bits on the CPU and the GPU. (Not the
+/// land's `field_hash`: `land` imports `frame`, which holds this module's
+/// layer, and the render modules' imports may not form a circle.)
 #[inline]
 pub fn cirrus_hash(ix: i32, iy: i32) -> f32 {
     let mut h = (ix as u32).wrapping_mul(0x8da6_b343) ^ (iy as u32).wrapping_mul(0xd816_3841);
@@ -142,16 +144,19 @@ pub fn cirrus_density(x: f32, z: f32, footprint_m: f32, layer: &CirrusLayer) -> 
 /// the cumulus are ([`aerial`]). `spread` is the pixel's cone angle
 /// (radians): the footprint on the layer grows with the distance and the
 /// slant. Rays that do not rise to the layer, and an eye at or above it,
-/// see the background alone.
+/// see the background alone, as every ray does without a `layer`.
 pub fn cirrus_over(
     sky: &SkyLight,
     eye: Vec3,
     dir: Vec3,
     sun_dir: Vec3,
     spread: f32,
-    layer: &CirrusLayer,
+    layer: Option<&CirrusLayer>,
     background: Vec3,
 ) -> Vec3 {
+    let Some(layer) = layer else {
+        return background;
+    };
     if dir.y <= 0.0 || eye.y >= layer.altitude_m {
         return background;
     }
@@ -246,29 +251,40 @@ mod tests {
         };
         let eye = Vec3::new(0.0, 100.0, 0.0);
         let background = Vec3::splat(1.0);
-        let toward = Vec3::new(0.0, 0.45, 0.89).normalize();
-        let away = Vec3::new(0.0, 0.45, -0.89).normalize();
-        let lit = cirrus_over(&sky, eye, toward, sun_dir, 1e-3, &layer, Vec3::ZERO);
-        let back = cirrus_over(&sky, eye, away, sun_dir, 1e-3, &layer, Vec3::ZERO);
+        // Summed over rays fanned across the sky toward the sun and their
+        // mirror images away from it (a single ray may meet a gap).
+        let (mut lit, mut back) = (Vec3::ZERO, Vec3::ZERO);
+        for k in 0..40 {
+            let x = -0.4 + 0.02 * k as f32;
+            let toward = Vec3::new(x, 0.45, 0.89).normalize();
+            let away = Vec3::new(x, 0.45, -0.89).normalize();
+            lit += cirrus_over(&sky, eye, toward, sun_dir, 1e-3, Some(&layer), Vec3::ZERO);
+            back += cirrus_over(&sky, eye, away, sun_dir, 1e-3, Some(&layer), Vec3::ZERO);
+        }
         assert!(lit.y > 3.0 * back.y, "toward the sun {lit}, away {back}");
         // Over a black sky it adds light; over a bright one it hides some.
         assert!(back.min_element() > 0.0);
-        let dimmed = cirrus_over(&sky, eye, Vec3::Y, sun_dir, 1e-3, &layer, background);
+        let dimmed = cirrus_over(&sky, eye, Vec3::Y, sun_dir, 1e-3, Some(&layer), background);
         assert!(dimmed.is_finite());
-        // Below the horizon, or from above the layer: the background.
+        // Without a layer, below the horizon, or from above the layer: the
+        // background.
+        assert_eq!(
+            cirrus_over(&sky, eye, Vec3::Y, sun_dir, 1e-3, None, background),
+            background
+        );
         let down = Vec3::new(0.0, -0.2, 1.0).normalize();
         assert_eq!(
-            cirrus_over(&sky, eye, down, sun_dir, 1e-3, &layer, background),
+            cirrus_over(&sky, eye, down, sun_dir, 1e-3, Some(&layer), background),
             background
         );
         let high = Vec3::new(0.0, 10_000.0, 0.0);
         assert_eq!(
-            cirrus_over(&sky, high, Vec3::Y, sun_dir, 1e-3, &layer, background),
+            cirrus_over(&sky, high, Vec3::Y, sun_dir, 1e-3, Some(&layer), background),
             background
         );
         // A grazing ray stays finite and at most opaque.
         let grazing = Vec3::new(0.0, 1e-4, 1.0).normalize();
-        let g = cirrus_over(&sky, eye, grazing, sun_dir, 1e-3, &layer, background);
+        let g = cirrus_over(&sky, eye, grazing, sun_dir, 1e-3, Some(&layer), background);
         assert!(g.is_finite(), "{g}");
     }
 }

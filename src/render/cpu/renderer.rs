@@ -123,10 +123,7 @@ pub fn march_ray(origin: Vec3, dir: Vec3, dither: f32, spread: f32, fr: &Frame) 
                 flat_ground_albedo(origin, dir, spread, fr),
                 (Vec3::ZERO, 1.0),
             );
-            let bg = match &q.cirrus {
-                Some(layer) => cirrus_over(sky, origin, dir, sun_dir, spread, layer, bg),
-                None => bg,
-            };
+            let bg = cirrus_over(sky, origin, dir, sun_dir, spread, q.cirrus.as_ref(), bg);
             (
                 bg + sea_reflection_change(origin, dir, dither, sun_dir, spread, fr),
                 q.max_distance_m,

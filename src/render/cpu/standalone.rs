@@ -176,10 +176,16 @@ pub fn render_standalone(
                     flat_ground_albedo(fr.view.eye(), dir, spread, fr),
                     (Vec3::ZERO, 1.0),
                 );
-                let bg = match &fr.quality.cirrus {
-                    Some(layer) => cirrus_over(sky, fr.view.eye(), dir, sun_dir, spread, layer, bg),
-                    None => bg,
-                };
+                let eye = fr.view.eye();
+                let bg = cirrus_over(
+                    sky,
+                    eye,
+                    dir,
+                    sun_dir,
+                    spread,
+                    fr.quality.cirrus.as_ref(),
+                    bg,
+                );
                 *px = c.truncate() + (1.0 - c.w) * bg;
             }
         });
